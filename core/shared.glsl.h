@@ -1,0 +1,83 @@
+/* veil — definitions shared by C and GLSL: binding slots, limits and the
+ * per-sample physics, so that the CPU tests exercise the same formulas as
+ * the shaders. Included by C code as a header, and prepended to every
+ * shader (after `#version 450` and `#define VEIL_GLSL 1`).
+ *
+ * Only scalar functions live here (C has no vec3); each is written once
+ * with the VEIL_* portability macros below.
+ */
+#ifndef VEIL_SHARED_GLSL_H
+#define VEIL_SHARED_GLSL_H
+
+#ifdef VEIL_GLSL
+#define VEIL_FN
+#define VEIL_EXPF exp
+#define VEIL_POWF pow
+#define VEIL_SQRTF sqrt
+#define VEIL_FLOAT(x) float(x)
+#else
+#include <math.h>
+#define VEIL_FN static inline
+#define VEIL_EXPF expf
+#define VEIL_POWF powf
+#define VEIL_SQRTF sqrtf
+#define VEIL_FLOAT(x) ((float)(x))
+#endif
+
+#define VEIL_PI 3.14159265358979323846
+
+/* A Gaussian particle is cut where it falls below this fraction of its peak
+ * (see volume/rbf.h for the mass this drops: 3.6e-4 of the particle). */
+#define VEIL_RBF_CUTOFF 1e-4
+
+/* Edge of a cubic brick of voxels: the unit of particle binning for the
+ * splat, and the compute work group of the inject and propagate passes
+ * (8^3 = 512 invocations, under GL's guaranteed minimum of 1024). */
+#define VEIL_BRICK 8
+
+/* Lights: four share one RGBA optical-depth texture. */
+#define VEIL_MAX_LIGHTS 16
+#define VEIL_MAX_OPV_TEXTURES (VEIL_MAX_LIGHTS / 4)
+#define VEIL_LIGHT_POINT 0
+#define VEIL_LIGHT_DIRECTIONAL 1
+
+/* Work group of the ray marcher: 8x8 pixels. */
+#define VEIL_MARCH_GROUP 8
+
+/* Rays stop when every channel's transmittance is below this: what is
+ * dropped is at most this fraction of the light behind (the attenuated
+ * background is still added with the transmittance reached). */
+#define VEIL_MIN_TRANSMITTANCE 1e-4
+
+/* Binding points. */
+#define VEIL_BIND_PARTICLES 0   /* SSBO: vec4 centre+amplitude, sharpness */
+#define VEIL_BIND_BRICK_START 1 /* SSBO: uint offsets per brick (+1) */
+#define VEIL_BIND_BRICK_LIST 2  /* SSBO: particle indices */
+#define VEIL_BIND_FLAGS 3       /* SSBO: uint "changed" flag of a Jacobi step */
+#define VEIL_IMAGE_EV 0         /* image unit: r32f extinction (density) volume */
+#define VEIL_IMAGE_OPV_SRC 1    /* image unit: rgba32f optical depth, read */
+#define VEIL_IMAGE_OPV_DST 2    /* image unit: rgba32f optical depth, written */
+#define VEIL_IMAGE_OUT 3        /* image unit: rgba32f output image */
+#define VEIL_TEX_EV 0           /* texture unit: sampled EV */
+#define VEIL_TEX_OPV0 1         /* texture units 1..4: sampled OPVs */
+
+/* Henyey–Greenstein phase function (sr^-1), cos_theta the cosine between the
+ * light's travel direction and the scattered direction; g = 0 is isotropic
+ * 1/(4 pi). The denominator is >= (1-|g|)^2 > 0 for |g| < 1. */
+VEIL_FN float veil_phase_hg(float cos_theta, float g)
+{
+    float denom = 1.0 + g * g - 2.0 * g * cos_theta;
+    return VEIL_FLOAT((1.0 - g * g) / (4.0 * VEIL_PI)) / (denom * VEIL_SQRTF(denom));
+}
+
+/* (1 - exp(-x)) / x for x >= 0: the fraction of a step of optical thickness
+ * x that in-scattered light survives, integrated over the step. Below 0.1 a
+ * 4-term series (truncation x^4/120 < 1e-6 relative), above it the direct
+ * form, whose cancellation error is ~eps/x < 1e-6. */
+VEIL_FN float veil_step_integral(float x)
+{
+    if (x < 0.1) return 1.0 - x * (0.5 - x * (1.0 / 6.0 - x * (1.0 / 24.0)));
+    return (1.0 - VEIL_EXPF(-x)) / x;
+}
+
+#endif
