@@ -1,0 +1,35 @@
+# Scene parser: unit test, and one CLI test per bad scene file.
+
+veil_test(test_scene SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_scene.c LABELS unit)
+
+# bad_input_<stem>: `veil render SCENE` must exit 1, print EXPECTED on stderr
+# and write no file (tests/bad_input.sh).
+function(veil_bad_input stem scene expected)
+  add_test(NAME bad_input_${stem}
+           COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/bad_input.sh $<TARGET_FILE:veil_cli> ${scene} "${expected}")
+  set_tests_properties(bad_input_${stem} PROPERTIES LABELS bad_input)
+endfunction()
+
+set(BAD ${CMAKE_CURRENT_SOURCE_DIR}/data/bad)
+veil_bad_input(syntax_error ${BAD}/syntax_error.json "syntax_error.json:6:3: JSON syntax error near")
+veil_bad_input(trailing_content ${BAD}/trailing_content.json
+               "trailing_content.json:5:1: JSON syntax error near '}': unexpected content after the JSON value")
+veil_bad_input(empty ${BAD}/empty.json "empty.json:1:1: JSON syntax error: unexpected end of input")
+veil_bad_input(not_an_object ${BAD}/not_an_object.json "expected a JSON object at the top level")
+veil_bad_input(wrong_type ${BAD}/wrong_type.json
+               "lights[1].intensity: expected an array of 3 numbers >= 0, got a string")
+veil_bad_input(unknown_key ${BAD}/unknown_key.json
+               "camera.fov: unknown key (expected one of: position, look_at, up, fov_y_deg, width, height)")
+veil_bad_input(missing_field ${BAD}/missing_field.json
+               "camera.position: missing required field (an array of 3 numbers)")
+veil_bad_input(negative_resolution ${BAD}/negative_resolution.json
+               "medium.max_resolution: expected an integer in [2, 2048], got -16 (negative and zero values are not allowed)")
+veil_bad_input(bad_phase_type ${BAD}/bad_phase_type.json "medium.phase.type: expected one of")
+veil_bad_input(g_out_of_range ${BAD}/g_out_of_range.json "medium.phase.g: expected a number in (-1, 1), got 1.5")
+veil_bad_input(zero_direction ${BAD}/zero_direction.json "lights[0].direction: expected a non-zero vector")
+veil_bad_input(bad_sharpness ${BAD}/bad_sharpness.json
+               "medium.sources[0].particles[1].sharpness: expected a number > 0, got 0")
+veil_bad_input(bad_seed ${BAD}/bad_seed.json "medium.sources[0].seed: expected an integer in [0, 2^53), got 1.5")
+veil_bad_input(camera_on_target ${BAD}/camera_on_target.json "camera.look_at: must differ from camera.position")
+veil_bad_input(missing_file ${BAD}/does_not_exist.json "does_not_exist.json: cannot open: No such file or directory")
+veil_bad_input(directory ${BAD} "bad: cannot read: Is a directory")
