@@ -1,0 +1,36 @@
+/* veil — image files: HDR EXR (OpenEXRCore) and an sRGB PNG preview (libpng).
+ *
+ * Pixels are linear RGBA floats, row-major, top row first, 4 floats a pixel.
+ * A is 1 - mean transmittance (0: nothing in front of the background).
+ * Writers write to a temporary file beside the target and rename it into
+ * place only when everything succeeded: a failed write leaves no file at
+ * `path` (and no temporary either).
+ */
+#ifndef VEIL_IMAGE_H
+#define VEIL_IMAGE_H
+
+#include "../core/result.h"
+
+/* EXR with channels R, G, B, A stored as 32-bit float, ZIP compression. */
+veil_result veil_write_exr(const char* path, int width, int height,
+                           const float* rgba, veil_error* err);
+
+/* Reads an EXR's R, G, B, A channels (A = 1 when absent) as float into a
+ * newly malloc'd buffer *rgba (free() it). Any scanline or tiled EXR that
+ * OpenEXRCore decodes with half or float channels. */
+veil_result veil_read_exr(const char* path, int* width, int* height,
+                          float** rgba, veil_error* err);
+
+/* 8-bit sRGB PNG preview, RGB (no alpha): each pixel's linear colour times
+ * 2^exposure, tone-mapped by veil_tonemap(), then sRGB-encoded. */
+veil_result veil_write_png(const char* path, int width, int height,
+                           const float* rgba, float exposure, veil_error* err);
+
+/* The preview's tone curve on one linear channel value: x / (1 + x)
+ * (Reinhard) applied to x >= 0; NaN and negatives map to 0. */
+float veil_tonemap(float x);
+
+/* sRGB opto-electronic transfer function (IEC 61966-2-1), input in [0,1]. */
+float veil_srgb_encode(float linear);
+
+#endif
