@@ -1,0 +1,43 @@
+#include "camera.h"
+
+#include <cglm/cglm.h>
+#include <math.h>
+
+veil_result veil_camera_make_basis(const veil_camera* c, int width, int height, veil_camera_basis* out,
+                                   veil_error* err)
+{
+    vec3 fwd, right, up, pos, at, upv;
+    glm_vec3_copy((float*)c->position, pos);
+    glm_vec3_copy((float*)c->look_at, at);
+    glm_vec3_copy((float*)c->up, upv);
+    glm_vec3_sub(at, pos, fwd);
+    if (!(glm_vec3_norm(fwd) > 0.0f))
+        return veil_fail(err, VEIL_ERR_INVALID, "camera: position and look_at coincide");
+    glm_vec3_normalize(fwd);
+    glm_vec3_cross(fwd, upv, right);
+    if (!(glm_vec3_norm(right) > 1e-6f * glm_vec3_norm(upv)))
+        return veil_fail(err, VEIL_ERR_INVALID, "camera: up is parallel to the view direction");
+    glm_vec3_normalize(right);
+    glm_vec3_cross(right, fwd, up);
+    float t = tanf(c->fov_y_deg * (float)(VEIL_PI / 360.0));
+    glm_vec3_scale(right, t * (float)width / (float)height, right);
+    glm_vec3_scale(up, t, up);
+    glm_vec3_copy(pos, out->pos);
+    glm_vec3_copy(fwd, out->fwd);
+    glm_vec3_copy(right, out->right);
+    glm_vec3_copy(up, out->up);
+    return VEIL_OK;
+}
+
+void veil_camera_ray(const veil_camera_basis* b, int width, int height, int px, int py, float dir[3])
+{
+    float sx = 2.0f * ((float)px + 0.5f) / (float)width - 1.0f;
+    float sy = 1.0f - 2.0f * ((float)py + 0.5f) / (float)height;
+    float n = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        dir[a] = b->fwd[a] + sx * b->right[a] + sy * b->up[a];
+        n += dir[a] * dir[a];
+    }
+    n = sqrtf(n);
+    for (int a = 0; a < 3; ++a) dir[a] /= n;
+}

@@ -1,0 +1,21 @@
+/* veil — the pinhole camera: position, look-at point, up vector and
+ * vertical field of view. Pixel (px, py), py = 0 the top row, looks along
+ * normalize(fwd + sx * right + sy * up) with sx = 2 (px + 0.5) / W - 1 and
+ * sy = 1 - 2 (py + 0.5) / H, where right and up are scaled by
+ * tan(fov_y / 2) (right also by the aspect W / H). render/shaders/march.comp
+ * uses the same formula. */
+#ifndef VEIL_CAMERA_H
+#define VEIL_CAMERA_H
+
+#include "../core/result.h"
+#include "../io/scene.h"
+
+typedef struct veil_camera_basis {
+    float pos[3], fwd[3], right[3], up[3];
+} veil_camera_basis;
+
+veil_result veil_camera_make_basis(const veil_camera* c, int width, int height, veil_camera_basis* out,
+                                   veil_error* err);
+void veil_camera_ray(const veil_camera_basis* b, int width, int height, int px, int py, float dir[3]);
+
+#endif

@@ -1,0 +1,33 @@
+#include "inject_gpu.h"
+
+#include "../render/gl_util.h"
+
+veil_result veil_inject_rbf_gpu(GLuint program, const veil_grid* g, const veil_rbf_bins* b,
+                                GLuint ev_texture, veil_error* err)
+{
+    size_t nb = (size_t)b->bricks[0] * b->bricks[1] * b->bricks[2];
+    GLuint buf[3] = {0, 0, 0};
+    veil_result r = veil_gl_buffer(b->packed, b->particle_count * 8 * sizeof(float), 0, "veil particles", &buf[0], err);
+    if (r == VEIL_OK) r = veil_gl_buffer(b->start, (nb + 1) * sizeof(uint32_t), 0, "veil brick starts", &buf[1], err);
+    if (r == VEIL_OK) r = veil_gl_buffer(b->list, b->list_len * sizeof(uint32_t), 0, "veil brick lists", &buf[2], err);
+    if (r == VEIL_OK) {
+        glUseProgram(program);
+        glProgramUniform3i(program, glGetUniformLocation(program, "u_dims"), g->dims[0], g->dims[1], g->dims[2]);
+        glProgramUniform3i(program, glGetUniformLocation(program, "u_bricks"), b->bricks[0], b->bricks[1], b->bricks[2]);
+        glProgramUniform3fv(program, glGetUniformLocation(program, "u_origin"), 1, g->origin);
+        glProgramUniform1f(program, glGetUniformLocation(program, "u_voxel"), g->voxel);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_PARTICLES, buf[0]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_BRICK_START, buf[1]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_BRICK_LIST, buf[2]);
+        glBindImageTexture(VEIL_IMAGE_EV, ev_texture, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+        glDispatchCompute((GLuint)b->bricks[0], (GLuint)b->bricks[1], (GLuint)b->bricks[2]);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                        GL_TEXTURE_UPDATE_BARRIER_BIT);
+        for (GLuint i = 0; i < 3; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_PARTICLES + i, 0);
+        glBindImageTexture(VEIL_IMAGE_EV, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+        glUseProgram(0);
+        r = veil_gl_check("RBF splat dispatch (volume/shaders/inject_rbf.comp)", err);
+    }
+    glDeleteBuffers(3, buf);
+    return r;
+}

@@ -1,0 +1,39 @@
+// veil — RBF splat into the extinction volume (density, r32f).
+// One work group per VEIL_BRICK^3 brick; each invocation is one voxel and
+// sums the Gaussians of its brick's particle list, in list order. Mirrors
+// veil_inject_rbf_cpu() operation for operation; `precise` forbids fused
+// multiply-adds so that the cut-off test r^2 <= r_cut^2 decides exactly as
+// in C.
+layout(local_size_x = VEIL_BRICK, local_size_y = VEIL_BRICK, local_size_z = VEIL_BRICK) in;
+
+struct Particle {
+    vec4 center_amp;  // centre (m), amplitude
+    vec4 shape;       // a^2 (m^-2), r_cut^2 (m^2), unused, unused
+};
+layout(std430, binding = VEIL_BIND_PARTICLES) readonly buffer Particles { Particle particles[]; };
+layout(std430, binding = VEIL_BIND_BRICK_START) readonly buffer BrickStart { uint brick_start[]; };
+layout(std430, binding = VEIL_BIND_BRICK_LIST) readonly buffer BrickList { uint brick_list[]; };
+layout(binding = VEIL_IMAGE_EV, r32f) writeonly uniform image3D u_ev;
+
+uniform ivec3 u_dims;
+uniform ivec3 u_bricks;
+uniform vec3 u_origin;
+uniform float u_voxel;
+
+void main()
+{
+    ivec3 v = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(v, u_dims))) return;
+    ivec3 b = ivec3(gl_WorkGroupID);
+    uint brick = uint((b.z * u_bricks.y + b.y) * u_bricks.x + b.x);
+    precise vec3 x = u_origin + (vec3(v) + 0.5) * u_voxel;
+    precise float sum = 0.0;
+    uint end = brick_start[brick + 1u];
+    for (uint e = brick_start[brick]; e < end; ++e) {
+        Particle p = particles[brick_list[e]];
+        precise vec3 d = x - p.center_amp.xyz;
+        precise float r2 = d.x * d.x + d.y * d.y + d.z * d.z;
+        if (r2 <= p.shape.y) sum += p.center_amp.w * exp(-(p.shape.x * r2));
+    }
+    imageStore(u_ev, v, vec4(sum));
+}

@@ -1,0 +1,58 @@
+/* veil — the extinction volume (EV): a dense grid of density over a
+ * world-space box, and the RBF splat that fills it.
+ *
+ * Geometry: cubic voxels of edge `voxel` (m); voxel (i,j,k) covers
+ * origin + [i, i+1) * voxel (likewise j, k) and its value is the density at
+ * its centre origin + (i + 0.5) * voxel. Between centres the medium is the
+ * trilinear interpolation of the values; inside the box and outside the
+ * outermost centres it is held constant (clamp to edge); outside the box
+ * there is no medium. Values are unitless density: extinction is
+ * sigma_t = (sigma_a + sigma_s) * density, per colour channel, in m^-1.
+ *
+ * The splat is particles x footprint, not particles x grid: particles are
+ * binned into VEIL_BRICK^3 bricks that their cut-off ball touches, and each
+ * voxel sums only its brick's list, in particle order. The CPU and GPU
+ * versions do exactly the same float operations in the same order.
+ */
+#ifndef VEIL_VOLUME_H
+#define VEIL_VOLUME_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../core/result.h"
+#include "rbf.h"
+
+typedef struct veil_grid {
+    int dims[3];      /* voxels per axis, >= 1 */
+    float origin[3];  /* world min corner (m) */
+    float voxel;      /* voxel edge (m), > 0 */
+} veil_grid;
+
+/* Fits a grid to the box [lo, hi] with `max_resolution` voxels along its
+ * longest side (centred, so the box grows by less than a voxel). */
+veil_result veil_grid_fit(const float lo[3], const float hi[3], int max_resolution,
+                          veil_grid* out, veil_error* err);
+
+size_t veil_grid_voxels(const veil_grid* g);
+/* World position of voxel (i, j, k)'s centre, computed as the shaders do. */
+void veil_grid_center(const veil_grid* g, int i, int j, int k, float out[3]);
+
+/* Particles binned into bricks (CSR lists) and packed for the GPU. */
+typedef struct veil_rbf_bins {
+    int bricks[3];         /* bricks per axis: ceil(dims / VEIL_BRICK) */
+    uint32_t* start;       /* bricks+1 offsets into list */
+    uint32_t* list;        /* particle indices, ascending within a brick */
+    size_t list_len;
+    float* packed;         /* 8 floats a particle: cx,cy,cz,c, a^2, r_cut^2, 0, 0 */
+    size_t particle_count;
+} veil_rbf_bins;
+
+veil_result veil_rbf_bin(const veil_grid* g, const veil_particle* p, size_t n,
+                         veil_rbf_bins* out, veil_error* err);
+void veil_rbf_bins_free(veil_rbf_bins* b);
+
+/* CPU splat: rho (veil_grid_voxels floats, x fastest) = sum of particles. */
+void veil_inject_rbf_cpu(const veil_grid* g, const veil_rbf_bins* b, float* rho);
+
+#endif
