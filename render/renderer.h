@@ -1,0 +1,70 @@
+/* veil — the renderer: runs the pipeline of a scene on the GPU.
+ *
+ *   particles --inject--> extinction volume (density, r32f 3D texture)
+ *             --propagate--> optical-depth volumes (rgba32f, 4 lights each)
+ *             --march--> linear RGBA image (rgb radiance, a = 1 - mean T)
+ *
+ * A renderer owns its compute programs and needs the veil_gl context that
+ * was current when it was created. Images are returned as newly malloc'd
+ * float RGBA, top row first (free() them).
+ */
+#ifndef VEIL_RENDERER_H
+#define VEIL_RENDERER_H
+
+#include <stdint.h>
+
+#include "../core/result.h"
+#include "../io/scene.h"
+#include "../propagate/opv.h"
+#include "../volume/volume.h"
+
+/* Ray-march step as a fraction of the voxel edge. Half a voxel resolves the
+ * trilinear medium between centres; the step error is measured, not assumed. */
+#define VEIL_DEFAULT_STEP_VOXELS 0.5f
+
+/* Jacobi stops when a checked step changes no optical depth sigma_t * D by
+ * more than this (unitless): well under the 8-bit resolution of a preview. */
+#define VEIL_OPV_TAU_TOLERANCE 1e-4f
+
+/* Point lights closer than this fraction of a voxel count as this far (the
+ * 1/r^2 singularity is integrable in the continuum but not in samples). */
+#define VEIL_MIN_LIGHT_DISTANCE_VOXELS 1e-3f
+
+typedef struct veil_renderer veil_renderer;
+
+typedef struct veil_render_opts {
+    int width, height;  /* 0: the scene camera's */
+    float step_voxels;  /* 0: VEIL_DEFAULT_STEP_VOXELS */
+    uint32_t seed;      /* jitter seed */
+} veil_render_opts;
+
+typedef struct veil_render_stats {
+    double inject_ms, propagate_ms, render_ms; /* wall time, GPU work finished */
+    int has_volume;       /* 0: nothing to inject (empty medium) */
+    veil_grid grid;       /* the EV's geometry when has_volume */
+    size_t particles;
+    int propagate_iterations;
+} veil_render_stats;
+
+veil_result veil_renderer_create(veil_renderer** out, veil_error* err);
+void veil_renderer_destroy(veil_renderer* r); /* accepts NULL */
+
+/* The whole pipeline for a scene. */
+veil_result veil_render_scene(veil_renderer* r, const veil_scene* s, const veil_render_opts* opts,
+                              float** rgba, veil_render_stats* stats, veil_error* err);
+
+/* Same, with the density given on a grid instead of injected from the
+ * scene's sources (tests, and later other sources). */
+veil_result veil_render_density(veil_renderer* r, const veil_scene* s, const veil_grid* g,
+                                const float* density, const veil_render_opts* opts, float** rgba,
+                                veil_render_stats* stats, veil_error* err);
+
+/* Stage access for tests: GPU splat read back (veil_grid_voxels floats) and
+ * GPU Jacobi read back (n_lights * voxels floats, light-major). */
+veil_result veil_renderer_inject(veil_renderer* r, const veil_grid* g, const veil_particle* p, size_t n,
+                                 float* density, veil_error* err);
+veil_result veil_renderer_propagate(veil_renderer* r, const veil_grid* g, const float* density,
+                                    const veil_opv_light* lights, int n_lights, const veil_opv_params* params,
+                                    float* out, int* iterations, veil_error* err);
+
+#endif

@@ -1,0 +1,10 @@
+veil_test(test_gpu_context SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_gpu_context.c LABELS gpu)
+veil_test(test_inject_gpu SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_inject_gpu.c LABELS gpu)
+veil_test(test_propagate_gpu SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_propagate_gpu.c LABELS gpu)
+veil_test(test_single_scatter SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_single_scatter.c LABELS "gpu;accuracy")
+
+# End to end through the CLI: the demo scene at a small size, gpuinfo, usage.
+add_test(NAME cli_end_to_end
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli_end_to_end.sh $<TARGET_FILE:veil_cli>
+          ${PROJECT_SOURCE_DIR}/data/scenes/demo.json)
+set_tests_properties(cli_end_to_end PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)

@@ -1,0 +1,66 @@
+/* The GPU splat (volume/shaders/inject_rbf.comp) equals the CPU one
+ * (veil_inject_rbf_cpu) on a small odd-sized grid.
+ *
+ * Both evaluate the same float operations in the same order; `precise`
+ * keeps the GPU from fusing multiply-adds, so the cut-off test decides the
+ * same way. They may differ only in exp(): GLSL 4.50 allows 3 + 2|x| ulp,
+ * glibc's expf is within 1 ulp, and |x| <= -ln(VEIL_RBF_CUTOFF) = 9.21, so
+ * each term differs by at most 22.4 + 1 ulp plus 1 ulp for the product
+ * with the amplitude. A sum of n positive terms computed in the same order
+ * then differs by at most (24.4 + n) ulp of the sum: relative
+ * (25 + n) * 2^-23 (an ulp is at most 2^-23 of the value). */
+#include <math.h>
+#include <stdlib.h>
+
+#include "check.h"
+#include "render/renderer.h"
+
+int main(void)
+{
+    veil_gl* gl = check_gpu_or_skip();
+    veil_renderer* r = NULL;
+    veil_error err = {0};
+    CHECK(veil_renderer_create(&r, &err) == VEIL_OK, "%s", err.msg);
+
+    veil_rbf_random_desc d = {.count = 400, .seed = 11, .bounds = {{0, 0, 0}, {1.3f, 1.0f, 0.8f}},
+                              .radius = {0.03f, 0.15f}, .amplitude = {0.2f, 3.0f}};
+    veil_particle* p = malloc(d.count * sizeof *p);
+    veil_rbf_random_generate(&d, p);
+    float lo[3], hi[3];
+    veil_rbf_bounds(p, d.count, lo, hi);
+    veil_grid g;
+    veil_grid_fit(lo, hi, 37, &g, &err);
+    size_t nv = veil_grid_voxels(&g);
+    float* cpu = malloc(nv * sizeof(float));
+    float* gpu = malloc(nv * sizeof(float));
+    veil_rbf_bins bins;
+    veil_rbf_bin(&g, p, d.count, &bins, &err);
+    veil_inject_rbf_cpu(&g, &bins, cpu);
+    CHECK(veil_renderer_inject(r, &g, p, d.count, gpu, &err) == VEIL_OK, "%s", err.msg);
+
+    int bad = 0;
+    double worst = 0.0, total = 0.0;
+    for (int k = 0; k < g.dims[2]; ++k)
+        for (int j = 0; j < g.dims[1]; ++j)
+            for (int i = 0; i < g.dims[0]; ++i) {
+                size_t v = ((size_t)k * g.dims[1] + j) * g.dims[0] + i;
+                size_t brick = ((size_t)(k / VEIL_BRICK) * bins.bricks[1] + j / VEIL_BRICK) * bins.bricks[0] + i / VEIL_BRICK;
+                double n = bins.start[brick + 1] - bins.start[brick];
+                double tol = (25.0 + n) * 0x1p-23 * fabs(cpu[v]);
+                double e = fabs((double)gpu[v] - cpu[v]);
+                if (!(e <= tol)) ++bad;
+                if (cpu[v] > 0) worst = fmax(worst, e / cpu[v]);
+                total += cpu[v];
+            }
+    printf("%dx%dx%d voxels, %u particles: largest relative GPU-CPU difference %.3g\n", g.dims[0], g.dims[1],
+           g.dims[2], d.count, worst);
+    CHECK(total > 0.0, "empty volume");
+    CHECK(bad == 0, "%d voxels differ beyond the exp() error bound", bad);
+    veil_rbf_bins_free(&bins);
+    free(cpu);
+    free(gpu);
+    free(p);
+    veil_renderer_destroy(r);
+    veil_gl_destroy(gl);
+    return check_finish();
+}

@@ -1,0 +1,75 @@
+/* The GPU Jacobi gather equals the CPU one, for lights inside and outside
+ * the grid and directional ones, five lights (two RGBA textures).
+ *
+ * Tolerance: both run the same float operations; GLSL 4.50 allows division
+ * 2.5 ulp and sqrt (as 1/inversesqrt) about 3 ulp where C is exact to 0.5,
+ * so one gather differs by at most ~8 ulp relative (the weights, one
+ * product, two sums). The gather is a convex combination of non-negative
+ * terms, so relative differences do not grow through it, only add up along
+ * the dependency chain, at most dims.x + dims.y + dims.z steps long:
+ * |gpu - cpu| <= 8 * (dims sum) * 2^-23 * cpu, plus the same relative bound
+ * on the largest value as an absolute floor for values near 0. */
+#include <math.h>
+#include <stdlib.h>
+
+#include "check.h"
+#include "render/renderer.h"
+
+int main(void)
+{
+    veil_gl* gl = check_gpu_or_skip();
+    veil_renderer* r = NULL;
+    veil_error err = {0};
+    CHECK(veil_renderer_create(&r, &err) == VEIL_OK, "%s", err.msg);
+
+    veil_grid g = {.dims = {20, 17, 13}, .origin = {0, 0, 0}, .voxel = 0.05f};
+    size_t nv = veil_grid_voxels(&g);
+    veil_rbf_random_desc d = {.count = 60, .seed = 5, .bounds = {{0, 0, 0}, {1.0f, 0.85f, 0.65f}},
+                              .radius = {0.05f, 0.2f}, .amplitude = {0.5f, 4.0f}};
+    veil_particle p[60];
+    veil_rbf_random_generate(&d, p);
+    veil_rbf_bins bins;
+    veil_rbf_bin(&g, p, d.count, &bins, &err);
+    float* rho = malloc(nv * sizeof(float));
+    veil_inject_rbf_cpu(&g, &bins, rho);
+    veil_rbf_bins_free(&bins);
+
+    const veil_light world[5] = {
+        {.type = VEIL_LIGHT_POINT, .position = {0.52f, 0.41f, 0.33f}},   /* inside, off-centre */
+        {.type = VEIL_LIGHT_POINT, .position = {-0.7f, 1.3f, 0.2f}},     /* outside */
+        {.type = VEIL_LIGHT_DIRECTIONAL, .direction = {0.48f, -0.8f, 0.36f}},
+        {.type = VEIL_LIGHT_DIRECTIONAL, .direction = {0, 0, 1}},
+        {.type = VEIL_LIGHT_POINT, .position = {2.0f, -1.0f, 3.0f}},     /* outside, other corner */
+    };
+    veil_opv_light lights[5];
+    for (int l = 0; l < 5; ++l) veil_opv_light_from_world(&g, &world[l], &lights[l]);
+
+    float* cpu = malloc(5 * nv * sizeof(float));
+    float* gpu = malloc(5 * nv * sizeof(float));
+    veil_opv_params exact = {0};
+    int it_cpu = 0, it_gpu = 0;
+    veil_opv_jacobi_cpu(&g, rho, lights, 5, &exact, cpu, &it_cpu, &err);
+    CHECK(veil_renderer_propagate(r, &g, rho, lights, 5, &exact, gpu, &it_gpu, &err) == VEIL_OK, "%s", err.msg);
+
+    double rel = 8.0 * (g.dims[0] + g.dims[1] + g.dims[2]) * 0x1p-23;
+    for (int l = 0; l < 5; ++l) {
+        double dmax = 0.0, worst = 0.0;
+        for (size_t v = 0; v < nv; ++v) dmax = fmax(dmax, cpu[l * nv + v]);
+        int bad = 0;
+        for (size_t v = 0; v < nv; ++v) {
+            double c = cpu[l * nv + v], e = fabs((double)gpu[l * nv + v] - c);
+            if (!(e <= rel * (c + dmax))) ++bad;
+            worst = fmax(worst, e / (c + dmax));
+        }
+        printf("light %d: max D %.4g, largest GPU-CPU difference %.3g of (D + max D)\n", l, dmax, worst);
+        CHECK(dmax > 0.0, "light %d: no optical depth at all", l);
+        CHECK(bad == 0, "light %d: %d voxels differ beyond %.3g relative", l, bad, rel);
+    }
+    printf("iterations: CPU %d, GPU %d (exact fixed point within %d)\n", it_cpu, it_gpu, veil_opv_exact_iterations(&g));
+    free(cpu);
+    free(gpu);
+    free(rho);
+    veil_renderer_destroy(r);
+    veil_gl_destroy(gl);
+    return check_finish();
+}
