@@ -455,7 +455,7 @@ static veil_result parse_lights(const ctx* c, const cJSON* root, veil_scene* s)
     size_t i = 0;
     TRY(get_container(c, root, &p, false, true, &arr));
     void* items = NULL;
-    TRY(alloc_items(c, &p, arr, sizeof *s->lights, SIZE_MAX, &items, &s->light_count));
+    TRY(alloc_items(c, &p, arr, sizeof *s->lights, VEIL_MAX_LIGHTS, &items, &s->light_count));
     s->lights = items;
     cJSON_ArrayForEach(e, arr) {
         const jpath ep = {&p, NULL, i};

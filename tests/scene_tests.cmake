@@ -31,5 +31,6 @@ veil_bad_input(bad_sharpness ${BAD}/bad_sharpness.json
                "medium.sources[0].particles[1].sharpness: expected a number > 0, got 0")
 veil_bad_input(bad_seed ${BAD}/bad_seed.json "medium.sources[0].seed: expected an integer in [0, 2^53), got 1.5")
 veil_bad_input(camera_on_target ${BAD}/camera_on_target.json "camera.look_at: must differ from camera.position")
+veil_bad_input(too_many_lights ${BAD}/too_many_lights.json "too_many_lights.json: lights: too many elements (17, at most 16)")
 veil_bad_input(missing_file ${BAD}/does_not_exist.json "does_not_exist.json: cannot open: No such file or directory")
 veil_bad_input(directory ${BAD} "bad: cannot read: Is a directory")
