@@ -62,6 +62,15 @@ static int fail(veil_result r, const veil_error* err)
     return exit_code(r);
 }
 
+/* "what went wrong" -> "scene.json: what went wrong", for errors that the
+ * scene's content caused but that were found while rendering it. */
+static void prefix_error(veil_error* err, const char* file)
+{
+    char tmp[VEIL_ERROR_MAX];
+    snprintf(tmp, sizeof tmp, "%.500s: %.1500s", file, err->msg);
+    memcpy(err->msg, tmp, sizeof tmp);
+}
+
 /* Parses a whole decimal integer in [lo, hi]. */
 static int parse_int(const char* s, long lo, long hi, long* out)
 {
@@ -158,8 +167,11 @@ static int cmd_render(int argc, char** argv)
     veil_render_opts opts = {.width = (int)a.width, .height = (int)a.height, .step_voxels = a.step,
                              .seed = (uint32_t)a.seed};
     r = veil_gl_create(NULL, &gl, &err);
-    if (r == VEIL_OK) r = veil_renderer_create(&ren, &err);
-    if (r == VEIL_OK) r = veil_render_scene(ren, &scene, &opts, &rgba, &st, &err);
+    if (r == VEIL_OK) r = veil_renderer_create(gl, &ren, &err);
+    if (r == VEIL_OK) {
+        r = veil_render_scene(ren, &scene, &opts, &rgba, &st, &err);
+        if (r != VEIL_OK && exit_code(r) == EXIT_INPUT) prefix_error(&err, a.scene);
+    }
     int w = a.width ? (int)a.width : scene.camera.width, h = a.height ? (int)a.height : scene.camera.height;
     double t_write = veil_now_ms();
     if (r == VEIL_OK) r = veil_write_exr(a.exr, w, h, rgba, &err);

@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L
 #include "gl_context.h"
 
 #include <epoxy/egl.h>
@@ -5,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #ifndef EGL_DEVICE_EXT
 #define EGL_DEVICE_EXT 0x322C
@@ -168,6 +170,25 @@ static void APIENTRY debug_callback(GLenum source, GLenum type, GLuint id, GLenu
     fprintf(stderr, "veil: GL debug: %s\n", message);
 }
 
+#ifndef GL_GPU_MEMORY_INFO_TOTAL_AVAILABLE_MEMORY_NVX
+#define GL_GPU_MEMORY_INFO_TOTAL_AVAILABLE_MEMORY_NVX 0x9048
+#endif
+
+static unsigned long long memory_budget(void)
+{
+    double bytes = 0.0;
+    if (epoxy_has_gl_extension("GL_NVX_gpu_memory_info")) {
+        GLint kib = 0;
+        glGetIntegerv(GL_GPU_MEMORY_INFO_TOTAL_AVAILABLE_MEMORY_NVX, &kib);
+        bytes = (double)kib * 1024.0;
+    }
+    if (!(bytes > 0.0)) {
+        long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+        bytes = pages > 0 && page > 0 ? (double)pages * (double)page : 1024.0 * 1024.0 * 1024.0;
+    }
+    return (unsigned long long)(bytes * VEIL_GPU_MEMORY_FRACTION);
+}
+
 veil_result veil_gl_create(const veil_gl_desc* desc, veil_gl** out, veil_error* err)
 {
     *out = NULL;
@@ -191,7 +212,8 @@ veil_result veil_gl_create(const veil_gl_desc* desc, veil_gl** out, veil_error* 
     if (has_ext(client, "EGL_EXT_platform_device") && has_ext(client, "EGL_EXT_device_enumeration"))
         r = try_device_platform(gl, &d, software_only, &first);
     else
-        veil_fail(&first, VEIL_ERR_GPU, "EGL_EXT_platform_device not offered");
+        veil_fail(&first, VEIL_ERR_GPU, "eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS) does not offer "
+                                        "EGL_EXT_platform_device with EGL_EXT_device_enumeration");
     if (r != VEIL_OK) {
         if (has_ext(client, "EGL_MESA_platform_surfaceless")) {
             r = try_surfaceless(gl, &d, err);
@@ -201,7 +223,11 @@ veil_result veil_gl_create(const veil_gl_desc* desc, veil_gl** out, veil_error* 
                 memcpy(err->msg, tmp, sizeof tmp);
             }
         } else {
-            r = veil_fail(err, VEIL_ERR_GPU, "%s; and EGL_MESA_platform_surfaceless is not offered", first.msg);
+            r = veil_fail(err, VEIL_ERR_GPU,
+                          "%.1000s; and eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS) does not offer "
+                          "EGL_MESA_platform_surfaceless (client extensions: %.600s; is an EGL vendor "
+                          "library such as libegl-mesa0 installed?)",
+                          first.msg, client);
         }
     }
     if (r != VEIL_OK) {
@@ -224,6 +250,7 @@ veil_result veil_gl_create(const veil_gl_desc* desc, veil_gl** out, veil_error* 
     if (strstr(gl->renderer, "llvmpipe") || strstr(gl->renderer, "softpipe")) gl->info.hardware = 0;
     glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &gl->info.max_3d_texture_size);
     glGetIntegerv(GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS, &gl->info.max_compute_work_group_invocations);
+    gl->info.memory_budget = memory_budget();
     if (d.debug) {
         glEnable(GL_DEBUG_OUTPUT);
         glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);

@@ -27,7 +27,13 @@ typedef struct veil_gl_info {
     const char* vendor, *renderer, *version;
     int max_3d_texture_size;
     int max_compute_work_group_invocations;
+    /* Bytes of textures veil allows itself: VEIL_GPU_MEMORY_FRACTION of the
+     * dedicated memory a GPU reports (GL_NVX_gpu_memory_info), else of the
+     * machine's physical memory (a software rasteriser's textures live there). */
+    unsigned long long memory_budget;
 } veil_gl_info;
+
+#define VEIL_GPU_MEMORY_FRACTION 0.5
 
 veil_result veil_gl_create(const veil_gl_desc* desc, veil_gl** out, veil_error* err);
 void veil_gl_destroy(veil_gl* gl); /* accepts NULL */

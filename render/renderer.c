@@ -11,13 +11,15 @@
 
 struct veil_renderer {
     GLuint inject, propagate, march;
+    unsigned long long memory_budget; /* bytes, see veil_gl_info */
 };
 
-veil_result veil_renderer_create(veil_renderer** out, veil_error* err)
+veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_error* err)
 {
     *out = NULL;
     veil_renderer* r = calloc(1, sizeof *r);
     if (!r) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the renderer");
+    r->memory_budget = veil_gl_get_info(gl)->memory_budget;
     veil_result res = veil_gl_compute_program("volume/shaders/inject_rbf.comp", veil_shader_inject_rbf_comp,
                                               &r->inject, err);
     if (res == VEIL_OK)
@@ -44,13 +46,20 @@ void veil_renderer_destroy(veil_renderer* r)
 
 /* GPU bytes of the EV and the OPVs (plus the scratch ping-pong texture),
  * checked for overflow before anything is allocated. */
-static veil_result check_volume_size(const veil_grid* g, int n_lights, veil_error* err)
+static veil_result check_volume_size(const veil_renderer* r, const veil_grid* g, int n_lights, veil_error* err)
 {
     size_t n_tex = (size_t)(n_lights + 3) / 4, bytes_ev, bytes_opv;
     if (!veil_mul_sizes((size_t)g->dims[0], (size_t)g->dims[1], (size_t)g->dims[2], sizeof(float), &bytes_ev) ||
-        !veil_mul_sizes(bytes_ev, 4, n_tex + 1, 1, &bytes_opv))
+        !veil_mul_sizes(bytes_ev, 4, n_lights > 0 ? n_tex + 1 : 0, 1, &bytes_opv) || bytes_opv > SIZE_MAX - bytes_ev)
         return veil_fail(err, VEIL_ERR_LIMIT, "a %dx%dx%d volume with %d lights overflows the address space",
                          g->dims[0], g->dims[1], g->dims[2], n_lights);
+    unsigned long long total = (unsigned long long)bytes_ev + bytes_opv;
+    if (total > r->memory_budget)
+        return veil_fail(err, VEIL_ERR_LIMIT,
+                         "a %dx%dx%d extinction volume with %d lights needs %.0f MiB of textures, more than the "
+                         "%.0f MiB allowed on this device; lower medium.max_resolution",
+                         g->dims[0], g->dims[1], g->dims[2], n_lights, (double)total / 1048576.0,
+                         (double)r->memory_budget / 1048576.0);
     return VEIL_OK;
 }
 
@@ -207,7 +216,7 @@ veil_result veil_render_density(veil_renderer* r, const veil_scene* s, const vei
     veil_render_stats st = {0};
     *rgba = NULL;
     GLuint ev = 0;
-    veil_result res = check_volume_size(g, (int)s->light_count, err);
+    veil_result res = check_volume_size(r, g, (int)s->light_count, err);
     double t0 = veil_now_ms();
     if (res == VEIL_OK) res = upload_density(g, density, &ev, err);
     glFinish();
@@ -238,7 +247,7 @@ veil_result veil_render_scene(veil_renderer* r, const veil_scene* s, const veil_
     st.has_volume = res == VEIL_OK && veil_rbf_bounds(parts, n, lo, hi);
     if (res == VEIL_OK && st.has_volume) {
         res = veil_grid_fit(lo, hi, s->medium.max_resolution, &g, err);
-        if (res == VEIL_OK) res = check_volume_size(&g, (int)s->light_count, err);
+        if (res == VEIL_OK) res = check_volume_size(r, &g, (int)s->light_count, err);
         if (res == VEIL_OK) res = veil_rbf_bin(&g, parts, n, &bins, err);
         if (res == VEIL_OK) res = veil_gl_texture3d(GL_R32F, g.dims, "veil extinction volume", &ev, err);
         if (res == VEIL_OK) res = veil_inject_rbf_gpu(r->inject, &g, &bins, ev, err);

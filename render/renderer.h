@@ -17,6 +17,7 @@
 #include "../io/scene.h"
 #include "../propagate/opv.h"
 #include "../volume/volume.h"
+#include "gl_context.h"
 
 /* Ray-march step as a fraction of the voxel edge. Half a voxel resolves the
  * trilinear medium between centres; the step error is measured, not assumed. */
@@ -46,8 +47,10 @@ typedef struct veil_render_stats {
     int propagate_iterations;
 } veil_render_stats;
 
-veil_result veil_renderer_create(veil_renderer** out, veil_error* err);
+veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_error* err);
 void veil_renderer_destroy(veil_renderer* r); /* accepts NULL */
+
+/* gl: the current context (its memory budget bounds the volumes). */
 
 /* The whole pipeline for a scene. */
 veil_result veil_render_scene(veil_renderer* r, const veil_scene* s, const veil_render_opts* opts,

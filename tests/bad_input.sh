@@ -41,6 +41,12 @@ logs=$(mktemp -d) || finish 1 "FAIL $name: mktemp failed"
 rc=$?
 err=$(head -c 2000 "$logs/stderr" | tr '\n' ' ')
 
+# Errors found only once rendering starts (a volume too large for the
+# device) need a GL context: without one that is a skip, as for every GPU
+# test, and a failure under CI=true.
+if [ "$rc" -eq 3 ] && [ "${CI:-}" != "true" ] && grep -q "no OpenGL\|eglInitialize\|eglQueryString" "$logs/stderr"; then
+    finish 77 "SKIPPED $name: no GL context: $err"
+fi
 if [ "$rc" -ne 1 ]; then
     finish 1 "FAIL $name: exit code $rc, expected 1; stderr: $err"
 fi

@@ -22,6 +22,21 @@ if ! "$veil" gpuinfo > "$tmp/gpuinfo.txt" 2> "$tmp/gpuinfo.err"; then
 fi
 grep -q 'GL version: *4\.[5-9]' "$tmp/gpuinfo.txt" || fail "gpuinfo: $(cat "$tmp/gpuinfo.txt")"
 
+# No GL context: Mesa told to load a driver that does not exist. The message
+# names the EGL call and its code, the exit code is 3, and no file appears.
+# (A hardware EGL device ignores GALLIUM_DRIVER: then this is not exercised.)
+if GALLIUM_DRIVER=veil-no-such-driver "$veil" gpuinfo > /dev/null 2> "$tmp/nogl.err"; then
+  echo "note: a hardware EGL device answered; the no-context path is not exercised here"
+else
+  rc=$?
+  [ $rc -eq 3 ] || fail "gpuinfo without a context exited $rc, expected 3"
+  grep -q 'eglInitialize.*(EGL_[A-Z_]*, 0x3[0-9a-f]*)' "$tmp/nogl.err" || fail "no EGL call and code in: $(cat "$tmp/nogl.err")"
+  GALLIUM_DRIVER=veil-no-such-driver "$veil" render "$scene" -o "$tmp/nogl.exr" --png "$tmp/nogl.png" 2>/dev/null
+  rc=$?
+  [ $rc -eq 3 ] || fail "render without a context exited $rc, expected 3"
+  [ -e "$tmp/nogl.exr" ] || [ -e "$tmp/nogl.png" ] && fail "render without a context left an output file"
+fi
+
 "$veil" render "$scene" -o "$tmp/demo.exr" --png "$tmp/demo.png" --width 96 --height 72 --stats > "$tmp/out.txt" \
   || fail "render failed: $(cat "$tmp/out.txt")"
 cat "$tmp/out.txt"

@@ -18,7 +18,7 @@ int main(void)
 
     veil_renderer* r = NULL;
     veil_error err = {0};
-    CHECK(veil_renderer_create(&r, &err) == VEIL_OK, "shaders failed: %s", err.msg);
+    CHECK(veil_renderer_create(gl, &r, &err) == VEIL_OK, "shaders failed: %s", err.msg);
     veil_renderer_destroy(r);
 
     GLuint prog = 0;

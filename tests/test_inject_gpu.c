@@ -20,7 +20,7 @@ int main(void)
     veil_gl* gl = check_gpu_or_skip();
     veil_renderer* r = NULL;
     veil_error err = {0};
-    CHECK(veil_renderer_create(&r, &err) == VEIL_OK, "%s", err.msg);
+    CHECK(veil_renderer_create(gl, &r, &err) == VEIL_OK, "%s", err.msg);
 
     veil_rbf_random_desc d = {.count = 400, .seed = 11, .bounds = {{0, 0, 0}, {1.3f, 1.0f, 0.8f}},
                               .radius = {0.03f, 0.15f}, .amplitude = {0.2f, 3.0f}};

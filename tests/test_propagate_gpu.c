@@ -20,7 +20,7 @@ int main(void)
     veil_gl* gl = check_gpu_or_skip();
     veil_renderer* r = NULL;
     veil_error err = {0};
-    CHECK(veil_renderer_create(&r, &err) == VEIL_OK, "%s", err.msg);
+    CHECK(veil_renderer_create(gl, &r, &err) == VEIL_OK, "%s", err.msg);
 
     veil_grid g = {.dims = {20, 17, 13}, .origin = {0, 0, 0}, .voxel = 0.05f};
     size_t nv = veil_grid_voxels(&g);

@@ -29,7 +29,7 @@ int main(void)
     veil_gl* gl = check_gpu_or_skip();
     veil_renderer* r = NULL;
     veil_error err = {0};
-    CHECK(veil_renderer_create(&r, &err) == VEIL_OK, "%s", err.msg);
+    CHECK(veil_renderer_create(gl, &r, &err) == VEIL_OK, "%s", err.msg);
 
     enum { N = 16, W = 33, H = 33 };
     const int row_voxel = 9; /* the camera's height is this voxel row's centre */
