@@ -19,6 +19,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "image.h"
+#include "tempfile.h"
 
 #include <openexr.h>
 
@@ -150,44 +151,6 @@ static int64_t fd_size(exr_const_context_t ctxt, void* userdata)
 }
 
 /* ------------------------------------------------------------------------ */
-/* Temporary file beside the target: "<path>.tmp<pid>.<n>", created with
- * O_EXCL and mode 0666 (less the umask, like any new file). An existing
- * target that is not a regular file (a directory, /dev/null, a FIFO) is
- * refused: renaming over it would replace it. Returns -1 with errno set, or
- * with errno 0 for that refusal. */
-
-static int open_temp_beside(const char* path, char** tmp_out)
-{
-    static atomic_uint counter;
-    struct stat st;
-    *tmp_out = NULL;
-    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
-        errno = 0;
-        return -1;
-    }
-    size_t n = strlen(path) + 48;
-    char* tmp = malloc(n);
-    if (!tmp) {
-        errno = ENOMEM;
-        return -1;
-    }
-    for (int attempt = 0; attempt < 100; ++attempt) {
-        unsigned k = atomic_fetch_add(&counter, 1u);
-        snprintf(tmp, n, "%s.tmp%ld.%u", path, (long)getpid(), k);
-        int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd >= 0) {
-            *tmp_out = tmp;
-            return fd;
-        }
-        if (errno != EEXIST) break;
-    }
-    int e = errno;
-    free(tmp);
-    errno = e;
-    return -1;
-}
-
-/* ------------------------------------------------------------------------ */
 /* Writing */
 
 /* Offset of a channel within an RGBA pixel, or -1. */
@@ -312,7 +275,7 @@ veil_result veil_write_exr(const char* path, int width, int height, const float*
     if (!rgba) return veil_fail(err, VEIL_ERR_INVALID, "%s: no pixel data given", path);
 
     char* tmp = NULL;
-    int fd = open_temp_beside(path, &tmp);
+    int fd = veil_open_temp_beside(path, &tmp);
     if (fd < 0 && errno == 0)
         return veil_fail(err, VEIL_ERR_IO, "%s: exists and is not a regular file; not replacing it", path);
     if (fd < 0)

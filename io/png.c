@@ -8,6 +8,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "image.h"
+#include "tempfile.h"
 
 #include <png.h>
 
@@ -44,42 +45,6 @@ static unsigned char encode_channel(float linear, float scale)
 {
     float v = veil_srgb_encode(veil_tonemap(linear * scale));
     return (unsigned char)floorf(v * 255.0f + 0.5f);
-}
-
-/* Temporary file beside the target: "<path>.tmp<pid>.<n>", created with
- * O_EXCL and mode 0666 (less the umask, like any new file). An existing
- * target that is not a regular file (a directory, /dev/null, a FIFO) is
- * refused: renaming over it would replace it. Returns -1 with errno set, or
- * with errno 0 for that refusal. */
-static int open_temp_beside(const char* path, char** tmp_out)
-{
-    static atomic_uint counter;
-    struct stat st;
-    *tmp_out = NULL;
-    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
-        errno = 0;
-        return -1;
-    }
-    size_t n = strlen(path) + 48;
-    char* tmp = malloc(n);
-    if (!tmp) {
-        errno = ENOMEM;
-        return -1;
-    }
-    for (int attempt = 0; attempt < 100; ++attempt) {
-        unsigned k = atomic_fetch_add(&counter, 1u);
-        snprintf(tmp, n, "%s.tmp%ld.%u", path, (long)getpid(), k);
-        int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd >= 0) {
-            *tmp_out = tmp;
-            return fd;
-        }
-        if (errno != EEXIST) break;
-    }
-    int e = errno;
-    free(tmp);
-    errno = e;
-    return -1;
 }
 
 typedef struct png_msg {
@@ -176,7 +141,7 @@ veil_result veil_write_png(const char* path, int width, int height, const float*
     if (!row) return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory for a PNG row of %d pixels", path, width);
 
     char* tmp = NULL;
-    int fd = open_temp_beside(path, &tmp);
+    int fd = veil_open_temp_beside(path, &tmp);
     if (fd < 0) {
         int e = errno;
         free(row);
