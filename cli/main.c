@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "io/image.h"
@@ -149,6 +150,23 @@ static int parse_render_args(int argc, char** argv, render_args* a)
     return -1;
 }
 
+/* The folder an output goes into must exist: found before rendering, not
+ * after seconds of work. */
+static veil_result check_output_folder(const char* path, veil_error* err)
+{
+    char dir[4096];
+    const char* slash = strrchr(path, '/');
+    if (!slash) return VEIL_OK;
+    size_t n = slash == path ? 1 : (size_t)(slash - path);
+    if (n >= sizeof dir) return veil_fail(err, VEIL_ERR_IO, "%s: path too long", path);
+    memcpy(dir, path, n);
+    dir[n] = '\0';
+    struct stat st;
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
+        return veil_fail(err, VEIL_ERR_IO, "%s: the folder '%s' does not exist", path, dir);
+    return VEIL_OK;
+}
+
 static int cmd_render(int argc, char** argv)
 {
     render_args a;
@@ -157,7 +175,10 @@ static int cmd_render(int argc, char** argv)
     double t_start = veil_now_ms();
     veil_error err = {0};
     veil_scene scene;
-    veil_result r = veil_scene_load(a.scene, &scene, &err);
+    veil_result r = check_output_folder(a.exr, &err);
+    if (r == VEIL_OK && a.png) r = check_output_folder(a.png, &err);
+    if (r != VEIL_OK) return fail(r, &err);
+    r = veil_scene_load(a.scene, &scene, &err);
     if (r != VEIL_OK) return fail(r, &err);
 
     veil_gl* gl = NULL;

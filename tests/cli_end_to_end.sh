@@ -13,6 +13,8 @@ fail() { echo "FAIL: $*"; exit 1; }
 "$veil" --help | grep -q 'usage: veil render' || fail "--help"
 "$veil" render >/dev/null 2>&1; [ $? -eq 2 ] || fail "render without arguments must exit 2"
 "$veil" render "$scene" -o "$tmp/x.exr" --width 0 2>/dev/null; [ $? -eq 2 ] || fail "--width 0 must exit 2"
+"$veil" render "$scene" -o "$tmp/no/such/dir/x.exr" 2> "$tmp/nodir.err"; [ $? -eq 1 ] || fail "missing output folder must exit 1"
+grep -q "the folder '$tmp/no/such/dir' does not exist" "$tmp/nodir.err" || fail "missing folder message: $(cat "$tmp/nodir.err")"
 "$veil" frobnicate 2>/dev/null; [ $? -eq 2 ] || fail "unknown command must exit 2"
 
 if ! "$veil" gpuinfo > "$tmp/gpuinfo.txt" 2> "$tmp/gpuinfo.err"; then
