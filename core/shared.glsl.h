@@ -11,17 +11,29 @@
 
 #ifdef VEIL_GLSL
 #define VEIL_FN
+#define VEIL_PRECISE precise
 #define VEIL_EXPF exp
 #define VEIL_POWF pow
 #define VEIL_SQRTF sqrt
+#define VEIL_ABSF abs
+#define VEIL_FLOORF floor
+#define VEIL_MINF min
+#define VEIL_MAXF max
 #define VEIL_FLOAT(x) float(x)
+#define VEIL_INT(x) int(x)
 #else
 #include <math.h>
 #define VEIL_FN static inline
+#define VEIL_PRECISE /* C is compiled with -ffp-contract=off */
 #define VEIL_EXPF expf
 #define VEIL_POWF powf
 #define VEIL_SQRTF sqrtf
+#define VEIL_ABSF fabsf
+#define VEIL_FLOORF floorf
+#define VEIL_MINF fminf
+#define VEIL_MAXF fmaxf
 #define VEIL_FLOAT(x) ((float)(x))
+#define VEIL_INT(x) ((int)(x))
 #endif
 
 #define VEIL_PI 3.14159265358979323846
@@ -40,6 +52,7 @@
 #define VEIL_MAX_OPV_TEXTURES (VEIL_MAX_LIGHTS / 4)
 #define VEIL_LIGHT_POINT 0
 #define VEIL_LIGHT_DIRECTIONAL 1
+#define VEIL_LIGHT_SPOT 2
 
 /* Work group of the ray marcher: 8x8 pixels. */
 #define VEIL_MARCH_GROUP 8
@@ -54,6 +67,7 @@
 #define VEIL_BIND_BRICK_START 1 /* SSBO: uint offsets per brick (+1) */
 #define VEIL_BIND_BRICK_LIST 2  /* SSBO: particle indices */
 #define VEIL_BIND_FLAGS 3       /* SSBO: uint "changed" flag of a Jacobi step */
+#define VEIL_BIND_FACES 4       /* SSBO: the faces of one sweep shell */
 #define VEIL_IMAGE_EV 0         /* image unit: r32f extinction (density) volume */
 #define VEIL_IMAGE_OPV_SRC 1    /* image unit: rgba32f optical depth, read */
 #define VEIL_IMAGE_OPV_DST 2    /* image unit: rgba32f optical depth, written */
@@ -68,6 +82,17 @@ VEIL_FN float veil_phase_hg(float cos_theta, float g)
 {
     float denom = 1.0 + g * g - 2.0 * g * cos_theta;
     return VEIL_FLOAT((1.0 - g * g) / (4.0 * VEIL_PI)) / (denom * VEIL_SQRTF(denom));
+}
+
+/* A spot light's intensity factor at angle theta from its axis, given
+ * cos(theta): 1 inside the inner cone, 0 outside the outer cone, and a
+ * smoothstep in cos(theta) between (C1, monotonic). cos_outer < cos_inner. */
+VEIL_FN float veil_spot_falloff(float cos_theta, float cos_inner, float cos_outer)
+{
+    if (cos_theta >= cos_inner) return 1.0;
+    if (cos_theta <= cos_outer) return 0.0;
+    float t = (cos_theta - cos_outer) / (cos_inner - cos_outer);
+    return t * t * (3.0 - 2.0 * t);
 }
 
 /* (1 - exp(-x)) / x for x >= 0: the fraction of a step of optical thickness

@@ -48,6 +48,7 @@ static const range R_ANY = {-DBL_MAX, DBL_MAX, false, false, false, "a number"};
 static const range R_NONNEG = {0, DBL_MAX, false, false, false, "a number >= 0"};
 static const range R_POS = {0, DBL_MAX, true, false, false, "a number > 0"};
 static const range R_FOV = {0, 180, true, true, false, "a number of degrees in (0, 180)"};
+static const range R_OUTER = {0, 180, true, false, false, "a number of degrees in (0, 180]"};
 static const range R_G = {-1, 1, true, true, false, "a number in (-1, 1)"};
 static const range R_SIZE = {1, VEIL_SCENE_MAX_IMAGE, false, false, true, "an integer in [1, 16384]"};
 static const range R_RES = {2, VEIL_SCENE_MAX_RESOLUTION, false, false, true, "an integer in [2, 2048]"};
@@ -64,9 +65,12 @@ static const char* const SOURCE_TYPES[] = {"rbf", "rbf_random", NULL}; /* = veil
 static const char* const RBF_KEYS[] = {"type", "particles", NULL};
 static const char* const RANDOM_KEYS[] = {"type", "count", "seed", "bounds", "radius", "amplitude", NULL};
 static const char* const PARTICLE_KEYS[] = {"center", "amplitude", "sharpness", NULL};
-static const char* const LIGHT_TYPES[] = {"point", "directional", NULL}; /* = veil_light_type */
+static const char* const LIGHT_TYPES[] = {"point", "directional", "spot", NULL}; /* = veil_light_type */
 static const char* const POINT_KEYS[] = {"type", "position", "intensity", NULL};
 static const char* const DIR_KEYS[] = {"type", "direction", "irradiance", NULL};
+static const char* const SPOT_KEYS[] = {"type", "position", "direction", "intensity", "inner_angle_deg",
+                                        "outer_angle_deg", NULL};
+static const char* const* const LIGHT_KEYS[] = {POINT_KEYS, DIR_KEYS, SPOT_KEYS}; /* by veil_light_type */
 static const char* const BACKGROUND_KEYS[] = {"color", NULL};
 
 /* ---- messages ---------------------------------------------------------- */
@@ -448,6 +452,20 @@ static veil_result parse_direction(const ctx* c, const cJSON* lo, const jpath* l
     return VEIL_OK;
 }
 
+/* A spot's cone: outer_angle_deg in (0, 180], then inner_angle_deg (default
+ * 0) in [0, outer), both as stored (floats), so that 0 <= inner < outer. */
+static veil_result parse_cone(const ctx* c, const cJSON* lo, const jpath* lp, veil_light* l)
+{
+    char what[96];
+    double outer, inner = 0;
+    TRY(get_number(c, lo, lp, "outer_angle_deg", true, &R_OUTER, &outer));
+    snprintf(what, sizeof what, "a number of degrees in [0, outer_angle_deg) = [0, %g)", outer);
+    const range r = {0, outer, false, true, false, what};
+    TRY(get_number(c, lo, lp, "inner_angle_deg", false, &r, &inner));
+    l->inner_angle_deg = (float)inner, l->outer_angle_deg = (float)outer;
+    return VEIL_OK;
+}
+
 static veil_result parse_lights(const ctx* c, const cJSON* root, veil_scene* s)
 {
     const jpath p = {NULL, "lights", 0};
@@ -464,15 +482,12 @@ static veil_result parse_lights(const ctx* c, const cJSON* root, veil_scene* s)
         if (!cJSON_IsObject(e)) return expected(c, &ep, "an object", e);
         TRY(get_kind(c, e, &ep, LIGHT_TYPES, &kind));
         l->type = (veil_light_type)kind;
-        if (kind == VEIL_LIGHT_POINT) {
-            TRY(check_keys(c, e, &ep, POINT_KEYS));
-            TRY(get_floats(c, e, &ep, "position", true, 3, false, l->position));
-            TRY(get_floats(c, e, &ep, "intensity", true, 3, true, l->color));
-        } else {
-            TRY(check_keys(c, e, &ep, DIR_KEYS));
-            TRY(parse_direction(c, e, &ep, l->direction));
-            TRY(get_floats(c, e, &ep, "irradiance", true, 3, true, l->color));
-        }
+        TRY(check_keys(c, e, &ep, LIGHT_KEYS[kind]));
+        if (kind != VEIL_LIGHT_DIRECTIONAL) TRY(get_floats(c, e, &ep, "position", true, 3, false, l->position));
+        if (kind != VEIL_LIGHT_POINT) TRY(parse_direction(c, e, &ep, l->direction));
+        const char* power = kind == VEIL_LIGHT_DIRECTIONAL ? "irradiance" : "intensity";
+        TRY(get_floats(c, e, &ep, power, true, 3, true, l->color));
+        if (kind == VEIL_LIGHT_SPOT) TRY(parse_cone(c, e, &ep, l));
     }
     return VEIL_OK;
 }

@@ -62,15 +62,18 @@ typedef struct veil_medium {
     size_t source_count;
 } veil_medium;
 
-/* VEIL_LIGHT_POINT or VEIL_LIGHT_DIRECTIONAL, defined in core/shared.glsl.h
+/* VEIL_LIGHT_POINT, VEIL_LIGHT_DIRECTIONAL or VEIL_LIGHT_SPOT (core/shared.glsl.h)
  * (the shaders use the same values); at most VEIL_MAX_LIGHTS lights. */
 typedef int veil_light_type;
 
 typedef struct veil_light {
     veil_light_type type;
-    float position[3];  /* point: m */
-    float direction[3]; /* directional: unit vector in which light travels */
-    float color[3];     /* point: intensity W/sr; directional: irradiance W/m^2 */
+    float position[3];  /* point, spot: m */
+    float direction[3]; /* directional, spot: unit vector in which light travels (spot: its axis) */
+    float color[3];     /* point, spot: intensity W/sr on the axis; directional: irradiance W/m^2 */
+    /* spot: full intensity within inner_angle_deg of the axis, none beyond
+     * outer_angle_deg, veil_spot_falloff() between; 0 <= inner < outer <= 180 */
+    float inner_angle_deg, outer_angle_deg;
 } veil_light;
 
 typedef struct veil_scene {

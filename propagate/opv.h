@@ -4,23 +4,28 @@
  * serves every channel of a single medium. Four lights share an RGBA
  * texture on the GPU (light 4t+c in channel c of texture t).
  *
- * The scheme here is the published ping-pong gather (Jacobi): each voxel
- * takes the cosine-weighted mean, over its up-wind axis neighbours (those
- * toward the light), of neighbour value + density along the step, where the
- * step is one voxel whatever the light direction (so the path measured is
- * Manhattan, not Euclidean: a known error that is measured, not hidden).
- * Details of this implementation:
- *  - the density along a step is the trapezoid h (rho(X) + rho(N)) / 2;
- *    a neighbour outside the grid holds D = 0 and the step to the box face
- *    is h/2 with rho(X);
- *  - a point light's own voxel (|d_a| <= 1/2 voxel on every axis) gets the
- *    straight segment rho(X) |X - S|; an axis with |d_a| <= 1/2 has no
- *    up-wind neighbour;
- *  - directional lights use the constant direction toward the light.
- * From D = 0 the iteration reaches its fixed point exactly after at most
- * dims.x + dims.y + dims.z + 1 steps (each dependency moves one voxel
- * toward the light); it stops earlier when no value changed by more than
- * `tolerance` in a checked step.
+ * Methods (each with a GPU version and a C version doing the same float
+ * operations; the per-voxel updates are in opv_schemes.glsl.h):
+ *  - VEIL_OPV_JACOBI: the published ping-pong gather. Each voxel takes the
+ *    cosine-weighted mean over its up-wind axis neighbours of neighbour
+ *    value + density along one voxel, iterated until a checked step changes
+ *    nothing by more than `tolerance`. One voxel per step whatever the
+ *    direction: in effect it measures Manhattan distance (56 % rms error in
+ *    a homogeneous medium around a point light).
+ *  - VEIL_OPV_JACOBI_CORRECTED: the same gather with the step length
+ *    h |d|_2 / sum|d_a|, the expected Euclidean progress of a step.
+ *  - VEIL_OPV_SWEEP: the corrected gather computed in dependency order: the
+ *    voxels at Manhattan distance m from the light's voxel (for a sun, from
+ *    the light-facing corner) depend only on distance m-1, so one pass over
+ *    m reaches the Jacobi fixed point exactly (bit for bit).
+ *  - VEIL_OPV_SEMI_LAGRANGIAN: follows the true light direction to the
+ *    next voxel plane along its dominant axis and interpolates D there
+ *    bilinearly (plus the trapezoid of the density on the way), in one
+ *    ordered pass: slices along the sun's dominant axis, or Chebyshev
+ *    shells around a point light's voxel (see opv_plan.h for why each
+ *    voxel reads only voxels already done); the 27 voxels around a point
+ *    light integrate their segment directly (VEIL_NEAR_SAMPLES points).
+ * Spot lights propagate as point lights (the cone only weights the marcher).
  */
 #ifndef VEIL_OPV_H
 #define VEIL_OPV_H
@@ -30,10 +35,33 @@
 #include "../io/scene.h"
 #include "../volume/volume.h"
 
+typedef enum veil_opv_method {
+    VEIL_OPV_DEFAULT = 0, /* resolves to VEIL_OPV_DEFAULT_METHOD */
+    VEIL_OPV_JACOBI,
+    VEIL_OPV_JACOBI_CORRECTED,
+    VEIL_OPV_SWEEP,
+    VEIL_OPV_SEMI_LAGRANGIAN,
+    VEIL_OPV_METHOD_COUNT
+} veil_opv_method;
+
+/* The default, chosen from the measurements in docs/performance.md. */
+#define VEIL_OPV_DEFAULT_METHOD VEIL_OPV_SEMI_LAGRANGIAN
+
+static inline veil_opv_method veil_opv_method_resolve(veil_opv_method m)
+{
+    return m == VEIL_OPV_DEFAULT ? VEIL_OPV_DEFAULT_METHOD : m;
+}
+
+/* "jacobi", "jacobi-corrected", "sweep", "semi-lagrangian" ("default" for 0) */
+const char* veil_opv_method_name(veil_opv_method m);
+/* 1 on success; names as above */
+int veil_opv_method_parse(const char* name, veil_opv_method* out);
+
 /* A light in voxel index space (voxel i's centre at coordinate i). */
 typedef struct veil_opv_light {
-    int type;   /* VEIL_LIGHT_POINT or VEIL_LIGHT_DIRECTIONAL */
-    float v[3]; /* point: position (index units); directional: unit vector toward the light */
+    int type;      /* VEIL_LIGHT_POINT (spot lights too) or VEIL_LIGHT_DIRECTIONAL */
+    float v[3];    /* point: position (index units); directional: unit vector toward the light */
+    int c[3];      /* point: the light's voxel, floor(v + 1/2) (it may lie outside the grid) */
 } veil_opv_light;
 
 void veil_opv_light_from_world(const veil_grid* g, const veil_light* l, veil_opv_light* out);
@@ -42,16 +70,27 @@ void veil_opv_light_from_world(const veil_grid* g, const veil_light* l, veil_opv
 #define VEIL_JACOBI_CHECK_EVERY 8
 
 typedef struct veil_opv_params {
-    float tolerance;    /* stop when a checked step changes no D by more than this (density·m); 0: run to the exact fixed point */
-    int max_iterations; /* 0: dims.x + dims.y + dims.z + 1 (exact) */
+    veil_opv_method method;
+    float tolerance;    /* Jacobi: stop when a checked step changes no D by more than this (density·m); 0: exact fixed point */
+    int max_iterations; /* Jacobi: 0 = dims.x + dims.y + dims.z + 1 (enough for the exact fixed point) */
+    float exit_steps;   /* semi-Lagrangian: integrate directly when the ray leaves the medium within this
+                           many steps; 0 = VEIL_SL_DEFAULT_EXIT_STEPS, at least 1 */
 } veil_opv_params;
+
+/* Chosen from the measurements in docs/performance.md. */
+#define VEIL_SL_DEFAULT_EXIT_STEPS 8.0f
+
+static inline float veil_opv_exit_steps(const veil_opv_params* p)
+{
+    return p->exit_steps >= 1.0f ? p->exit_steps : VEIL_SL_DEFAULT_EXIT_STEPS;
+}
 
 int veil_opv_exact_iterations(const veil_grid* g);
 
-/* CPU reference of the GPU scheme: out holds n_lights * voxels floats,
- * light-major, x fastest. *iterations receives the steps run. */
-veil_result veil_opv_jacobi_cpu(const veil_grid* g, const float* rho, const veil_opv_light* lights,
-                                int n_lights, const veil_opv_params* params, float* out,
-                                int* iterations, veil_error* err);
+/* C version of every method: out holds n_lights * voxels floats,
+ * light-major, x fastest. *iterations: Jacobi steps, or passes (dispatches
+ * on the GPU) of an ordered method. */
+veil_result veil_opv_cpu(const veil_grid* g, const float* rho, const veil_opv_light* lights, int n_lights,
+                         const veil_opv_params* params, float* out, int* iterations, veil_error* err);
 
 #endif

@@ -1,16 +1,63 @@
-#include "opv.h"
-
+/* The C versions of the optical-depth methods: the per-voxel updates come
+ * from opv_schemes.glsl.h (the shaders' own code), the order from
+ * opv_plan.c (the GPU's dispatch order). */
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "opv.h"
+#include "opv_plan.h"
+
+typedef struct veil__opv_ctx {
+    const float* rho;
+    const float* din;
+    int dims[3];
+} veil__opv_ctx;
+
+#define VEIL_CTX_PARAM const veil__opv_ctx *ctx,
+#define VEIL_CTX_ARG ctx,
+#define VEIL_DIMS(a) (ctx->dims[(a)])
+#define VEIL__IDX(i, j, k) (((size_t)(k) * (size_t)ctx->dims[1] + (size_t)(j)) * (size_t)ctx->dims[0] + (size_t)(i))
+#define VEIL_RHO(i, j, k) (ctx->rho[VEIL__IDX(i, j, k)])
+#define VEIL_DIN(i, j, k) (ctx->din[VEIL__IDX(i, j, k)])
+#include "opv_schemes.glsl.h"
+
+static size_t vox(const veil_grid* g, const int x[3])
+{
+    return ((size_t)x[2] * (size_t)g->dims[1] + (size_t)x[1]) * (size_t)g->dims[0] + (size_t)x[0];
+}
+
+static const char* const method_names[VEIL_OPV_METHOD_COUNT] = {"default", "jacobi", "jacobi-corrected",
+                                                                "sweep", "semi-lagrangian"};
+
+const char* veil_opv_method_name(veil_opv_method m)
+{
+    return (unsigned)m < VEIL_OPV_METHOD_COUNT ? method_names[m] : "unknown";
+}
+
+int veil_opv_method_parse(const char* name, veil_opv_method* out)
+{
+    for (int m = 0; m < VEIL_OPV_METHOD_COUNT; ++m)
+        if (strcmp(name, method_names[m]) == 0) {
+            *out = (veil_opv_method)m;
+            return 1;
+        }
+    return 0;
+}
+
 void veil_opv_light_from_world(const veil_grid* g, const veil_light* l, veil_opv_light* out)
 {
-    out->type = l->type;
-    if (l->type == VEIL_LIGHT_POINT) {
-        for (int a = 0; a < 3; ++a) out->v[a] = (l->position[a] - g->origin[a]) / g->voxel - 0.5f;
-    } else {
-        for (int a = 0; a < 3; ++a) out->v[a] = -l->direction[a];
+    memset(out, 0, sizeof *out);
+    out->type = l->type == VEIL_LIGHT_DIRECTIONAL ? VEIL_LIGHT_DIRECTIONAL : VEIL_LIGHT_POINT;
+    for (int a = 0; a < 3; ++a) {
+        if (out->type == VEIL_LIGHT_POINT) {
+            out->v[a] = (l->position[a] - g->origin[a]) / g->voxel - 0.5f;
+            double c = floor((double)out->v[a] + 0.5);
+            out->c[a] = c < -1e9 ? -1000000000 : (c > 1e9 ? 1000000000 : (int)c);
+        } else {
+            out->v[a] = -l->direction[a];
+        }
     }
 }
 
@@ -19,69 +66,129 @@ int veil_opv_exact_iterations(const veil_grid* g)
     return g->dims[0] + g->dims[1] + g->dims[2] + 1;
 }
 
-static size_t vidx(const veil_grid* g, int i, int j, int k)
+static void jacobi(const veil_grid* g, const float* rho, const veil_opv_light* L, const veil_opv_params* p,
+                   float* cur, float* tmp, int* iterations)
 {
-    return ((size_t)k * g->dims[1] + j) * g->dims[0] + i;
-}
-
-/* One voxel's update; mirrors propagate_jacobi.comp operation for operation. */
-static float gather(const veil_grid* g, const float* rho, const float* src, const veil_opv_light* L,
-                    int i, int j, int k)
-{
-    const int x[3] = {i, j, k};
-    float d[3];
-    for (int a = 0; a < 3; ++a) d[a] = L->type == VEIL_LIGHT_POINT ? L->v[a] - (float)x[a] : L->v[a];
-    const float lim = L->type == VEIL_LIGHT_POINT ? 0.5f : 0.0f;
-    const float h = g->voxel;
-    const float r = rho[vidx(g, i, j, k)];
-    float wsum = 0.0f;
-    for (int a = 0; a < 3; ++a)
-        if (fabsf(d[a]) > lim) wsum += fabsf(d[a]);
-    if (wsum == 0.0f) /* the light is inside this voxel */
-        return r * (h * sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
-    float acc = 0.0f;
-    for (int a = 0; a < 3; ++a) {
-        if (!(fabsf(d[a]) > lim)) continue;
-        int n[3] = {i, j, k};
-        n[a] += d[a] > 0.0f ? 1 : -1;
-        float term;
-        if (n[a] < 0 || n[a] >= g->dims[a]) {
-            term = 0.5f * h * r;
-        } else {
-            size_t ni = vidx(g, n[0], n[1], n[2]);
-            term = src[ni] + 0.5f * h * (r + rho[ni]);
-        }
-        acc += (fabsf(d[a]) / wsum) * term;
+    veil__opv_ctx ctx = {.rho = rho, .din = cur, .dims = {g->dims[0], g->dims[1], g->dims[2]}};
+    size_t nv = veil_grid_voxels(g);
+    int corrected = p->method == VEIL_OPV_JACOBI_CORRECTED;
+    int max_it = p->max_iterations > 0 ? p->max_iterations : veil_opv_exact_iterations(g);
+    memset(cur, 0, nv * sizeof(float));
+    int it = 0;
+    while (it < max_it) {
+        int check = (it % VEIL_JACOBI_CHECK_EVERY) == VEIL_JACOBI_CHECK_EVERY - 1;
+        float change = 0.0f;
+        size_t v = 0;
+        for (int k = 0; k < g->dims[2]; ++k)
+            for (int j = 0; j < g->dims[1]; ++j)
+                for (int i = 0; i < g->dims[0]; ++i, ++v) {
+                    tmp[v] = veil_gather_cell(&ctx, i, j, k, L->type, L->v[0], L->v[1], L->v[2], L->c[0], L->c[1],
+                                              L->c[2], g->voxel, corrected);
+                    change = fmaxf(change, fabsf(tmp[v] - cur[v]));
+                }
+        memcpy(cur, tmp, nv * sizeof(float));
+        ++it;
+        if (check && change <= p->tolerance) break;
     }
-    return acc;
+    *iterations = it;
 }
 
-veil_result veil_opv_jacobi_cpu(const veil_grid* g, const float* rho, const veil_opv_light* lights,
-                                int n_lights, const veil_opv_params* params, float* out,
-                                int* iterations, veil_error* err)
+static void gather_sweep(const veil_grid* g, const float* rho, const veil_opv_light* L, float* out, int* passes)
+{
+    veil__opv_ctx ctx = {.rho = rho, .din = out, .dims = {g->dims[0], g->dims[1], g->dims[2]}};
+    veil__gather_plan plan;
+    veil__gather_plan_make(g, L, &plan);
+    int s = plan.solve, u = s == 0 ? 1 : 0, w = s == 2 ? 1 : 2;
+    for (int m = plan.first; m <= plan.last; ++m) {
+        for (int b = 0; b < g->dims[w]; ++b)
+            for (int a = 0; a < g->dims[u]; ++a) {
+                int x[3], sol[2];
+                x[u] = a;
+                x[w] = b;
+                x[s] = 0;
+                int n = veil__gather_solve(g, L, &plan, m, x, sol);
+                for (int q = 0; q < n; ++q) {
+                    x[s] = sol[q];
+                    out[vox(g, x)] = veil_gather_cell(&ctx, x[0], x[1], x[2], L->type, L->v[0], L->v[1],
+                                                               L->v[2], L->c[0], L->c[1], L->c[2], g->voxel, 1);
+                }
+            }
+    }
+    *passes = plan.last - plan.first + 1;
+}
+
+/* Runs f over every voxel of a box (x fastest). */
+#define FOR_BOX(b, x)                                                                \
+    for (x[2] = (b).lo[2]; x[2] < (b).lo[2] + (b).n[2]; ++x[2])                      \
+        for (x[1] = (b).lo[1]; x[1] < (b).lo[1] + (b).n[1]; ++x[1])                  \
+            for (x[0] = (b).lo[0]; x[0] < (b).lo[0] + (b).n[0]; ++x[0])
+
+static float sl_voxel(const veil__opv_ctx* ctx, const veil_opv_light* L, const int x[3], float h, float exit_steps)
+{
+    int a = veil_sl_axis(x[0], x[1], x[2], L->type, L->v[0], L->v[1], L->v[2], L->c[0], L->c[1], L->c[2]);
+    return veil_sl_cell(ctx, x[0], x[1], x[2], a, L->type, L->v[0], L->v[1], L->v[2], h, exit_steps);
+}
+
+static void semi_lagrangian(const veil_grid* g, const float* rho, const veil_opv_light* L, float exit_steps, float* out,
+                            int* passes)
+{
+    veil__opv_ctx ctx = {.rho = rho, .din = out, .dims = {g->dims[0], g->dims[1], g->dims[2]}};
+    int x[3], n = 0;
+    veil__box box;
+    if (L->type == VEIL_LIGHT_DIRECTIONAL) {
+        int a = veil__sl_sun_axis(L);
+        for (int k = 0; k < g->dims[a]; ++k, ++n) {
+            veil__sl_sun_slice(g, L, k, &box);
+            FOR_BOX(box, x) out[vox(g, x)] = sl_voxel(&ctx, L, x, g->voxel, exit_steps);
+        }
+        *passes = n;
+        return;
+    }
+    if (veil__sl_near_box(g, L, &box)) {
+        FOR_BOX(box, x) out[vox(g, x)] = veil_near_cell(&ctx, x[0], x[1], x[2], L->v[0], L->v[1], L->v[2], g->voxel);
+        ++n;
+    }
+    int s0, s1;
+    veil__sl_shell_range(g, L, &s0, &s1);
+    for (int s = s0; s <= s1; ++s)
+        for (int k = 1; k <= 3; ++k) {
+            veil__box boxes[VEIL_SL_MAX_BOXES];
+            int nb = veil__sl_boxes(g, L, s, k, boxes);
+            for (int b = 0; b < nb; ++b) FOR_BOX(boxes[b], x) out[vox(g, x)] = sl_voxel(&ctx, L, x, g->voxel, exit_steps);
+            n += nb > 0;
+        }
+    *passes = n;
+}
+
+veil_result veil_opv_cpu(const veil_grid* g, const float* rho, const veil_opv_light* lights, int n_lights,
+                         const veil_opv_params* params, float* out, int* iterations, veil_error* err)
 {
     size_t nv = veil_grid_voxels(g);
-    float* tmp = malloc(nv * sizeof(float));
-    if (!tmp) return veil_fail(err, VEIL_ERR_OOM, "out of memory for a %zu-voxel optical-depth volume", nv);
-    int max_it = params->max_iterations > 0 ? params->max_iterations : veil_opv_exact_iterations(g);
+    float* tmp = NULL;
+    veil_opv_params resolved = *params;
+    resolved.method = veil_opv_method_resolve(params->method);
+    params = &resolved;
+    if (params->method == VEIL_OPV_JACOBI || params->method == VEIL_OPV_JACOBI_CORRECTED) {
+        tmp = malloc(nv * sizeof(float));
+        if (!tmp) return veil_fail(err, VEIL_ERR_OOM, "out of memory for a %zu-voxel optical-depth volume", nv);
+    } else if ((unsigned)params->method >= VEIL_OPV_METHOD_COUNT) {
+        return veil_fail(err, VEIL_ERR_INVALID, "unknown propagation method %d", (int)params->method);
+    }
     int most = 0;
     for (int l = 0; l < n_lights; ++l) {
         float* cur = out + (size_t)l * nv;
-        memset(cur, 0, nv * sizeof(float));
         int it = 0;
-        while (it < max_it) {
-            int check = (it % VEIL_JACOBI_CHECK_EVERY) == VEIL_JACOBI_CHECK_EVERY - 1;
-            float change = 0.0f;
-            for (int k = 0; k < g->dims[2]; ++k)
-                for (int j = 0; j < g->dims[1]; ++j)
-                    for (int i = 0; i < g->dims[0]; ++i) {
-                        size_t v = vidx(g, i, j, k);
-                        tmp[v] = gather(g, rho, cur, &lights[l], i, j, k);
-                        change = fmaxf(change, fabsf(tmp[v] - cur[v]));
-                    }
-            memcpy(cur, tmp, nv * sizeof(float));
-            ++it;
-            if (check && change <= params->tolerance) break;
+        switch (params->method) {
+        case VEIL_OPV_JACOBI:
+        case VEIL_OPV_JACOBI_CORRECTED: jacobi(g, rho, &lights[l], params, cur, tmp, &it); break;
+        case VEIL_OPV_SWEEP:
+            memset(cur, 0, nv * sizeof(float));
+            gather_sweep(g, rho, &lights[l], cur, &it);
+            break;
+        default:
+            memset(cur, 0, nv * sizeof(float));
+            semi_lagrangian(g, rho, &lights[l], veil_opv_exit_steps(params), cur, &it);
+            break;
         }
         if (it > most) most = it;
     }

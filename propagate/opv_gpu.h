@@ -1,7 +1,8 @@
-/* veil — the published Jacobi gather on the GPU
- * (propagate/shaders/propagate_jacobi.comp), four lights per rgba32f
- * texture, ping-pong between the caller's texture and a scratch one.
- * Same scheme and same float operations as veil_opv_jacobi_cpu(). */
+/* veil — the optical-depth methods on the GPU: the Jacobi ping-pong
+ * (propagate/shaders/propagate_jacobi.comp, four lights per step) and the
+ * ordered one-pass methods (propagate/shaders/propagate_sweep.comp, one
+ * light at a time, in place). Same per-voxel code and order as
+ * veil_opv_cpu(). */
 #ifndef VEIL_OPV_GPU_H
 #define VEIL_OPV_GPU_H
 
@@ -9,11 +10,18 @@
 
 #include "opv.h"
 
+typedef struct veil_opv_programs {
+    GLuint jacobi, sweep;
+} veil_opv_programs;
+
+veil_result veil_opv_programs_create(veil_opv_programs* p, veil_error* err);
+void veil_opv_programs_destroy(veil_opv_programs* p);
+
 /* Fills opv[t] (ceil(n_lights/4) rgba32f textures of the grid's size, made
  * by the caller) for lights 4t..4t+3; ev is the r32f density texture.
- * *iterations: the most Jacobi steps any texture needed. */
-veil_result veil_opv_jacobi_gpu(GLuint program, const veil_grid* g, GLuint ev, const veil_opv_light* lights,
-                                int n_lights, const veil_opv_params* params, const GLuint* opv,
-                                int* iterations, veil_error* err);
+ * *iterations: the most Jacobi steps, or sweep passes, any light needed. */
+veil_result veil_opv_gpu(const veil_opv_programs* p, const veil_grid* g, GLuint ev, const veil_opv_light* lights,
+                         int n_lights, const veil_opv_params* params, const GLuint* opv, int* iterations,
+                         veil_error* err);
 
 #endif

@@ -1,6 +1,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "gl_util.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -45,21 +46,55 @@ static char* info_log(GLuint obj, int is_program)
     return log;
 }
 
+/* The shader line that pulls in an embedded header (GLSL has no #include). */
+#define VEIL__INCLUDE_MARK "//@include "
+
 veil_result veil_gl_compute_program(const char* file, const char* source, GLuint* out, veil_error* err)
 {
     *out = 0;
-    /* #line 1 1: the shader file is source string 1 in driver logs, so its
-     * line numbers are the file's own; 0 is the shared header. */
-    const char* parts[] = {"#version 450 core\n#define VEIL_GLSL 1\n#line 1 0\n", veil_shader_shared_glsl_h,
-                           "\n#line 1 1\n", source};
+    /* Source strings: 0 = core/shared.glsl.h, 1 = the shader file, 2 = an
+     * included header; #line keeps each one's own line numbers in logs. */
+    const char* parts[8] = {"#version 450 core\n#define VEIL_GLSL 1\n#line 1 0\n", veil_shader_shared_glsl_h,
+                            "\n#line 1 1\n"};
+    GLint lens[8] = {-1, -1, -1};
+    int n = 3;
+    char resume[64] = "";
+    const char* mark = strstr(source, VEIL__INCLUDE_MARK);
+    if (mark) {
+        const char* name = mark + strlen(VEIL__INCLUDE_MARK);
+        const char* eol = strchr(name, '\n');
+        size_t name_len = eol ? (size_t)(eol - name) : strlen(name);
+        const char* header = NULL;
+        if (name_len == strlen("propagate/opv_schemes.glsl.h") && !strncmp(name, "propagate/opv_schemes.glsl.h", name_len))
+            header = veil_shader_opv_schemes_glsl_h;
+        if (!header)
+            return veil_fail(err, VEIL_ERR_SHADER, "%s: unknown include '%.*s'", file, (int)name_len, name);
+        int line = 1;
+        for (const char* c = source; c < mark; ++c) line += *c == '\n';
+        snprintf(resume, sizeof resume, "\n#line %d 1\n", line + 1);
+        parts[n] = source;
+        lens[n++] = (GLint)(mark - source);
+        parts[n] = "\n#line 1 2\n";
+        lens[n++] = -1;
+        parts[n] = header;
+        lens[n++] = -1;
+        parts[n] = resume;
+        lens[n++] = -1;
+        parts[n] = eol ? eol : "";
+        lens[n++] = -1;
+    } else {
+        parts[n] = source;
+        lens[n++] = -1;
+    }
     GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
-    glShaderSource(sh, 4, parts, NULL);
+    glShaderSource(sh, n, parts, lens);
     glCompileShader(sh);
     GLint ok = 0;
     glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
     if (!ok) {
         char* log = info_log(sh, 0);
-        veil_fail(err, VEIL_ERR_SHADER, "%s: compile failed (source 1 is this file, 0 is core/shared.glsl.h):\n%s",
+        veil_fail(err, VEIL_ERR_SHADER,
+                  "%s: compile failed (in the log, source 1 is this file, 0 core/shared.glsl.h, 2 its include):\n%s",
                   file, log ? log : "(no log)");
         free(log);
         glDeleteShader(sh);

@@ -15,10 +15,13 @@
 extern const char veil_shader_shared_glsl_h[];
 extern const char veil_shader_inject_rbf_comp[];
 extern const char veil_shader_propagate_jacobi_comp[];
+extern const char veil_shader_propagate_sweep_comp[];
+extern const char veil_shader_opv_schemes_glsl_h[];
 extern const char veil_shader_march_comp[];
 
 /* Compiles and links a compute program: "#version 450", VEIL_GLSL, the
- * shared header, then `source`. `file` (e.g. "render/shaders/march.comp")
+ * shared header, then `source`, where a line `//@include NAME` is replaced
+ * by the embedded header NAME (only propagate/opv_schemes.glsl.h). `file` (e.g. "render/shaders/march.comp")
  * names the shader in errors and in the object label. */
 veil_result veil_gl_compute_program(const char* file, const char* source, GLuint* out, veil_error* err);
 

@@ -10,9 +10,33 @@
 #include "gl_util.h"
 
 struct veil_renderer {
-    GLuint inject, propagate, march;
+    GLuint inject, march;
+    veil_opv_programs opv_programs;
     unsigned long long memory_budget; /* bytes, see veil_gl_info */
+    /* the cached extinction volume and what it was made from */
+    uint64_t ev_key;
+    GLuint ev;
+    int has_volume;
+    veil_grid grid;
+    size_t particles;
+    /* the cached optical-depth textures and what each was made from */
+    uint64_t opv_key[VEIL_MAX_OPV_TEXTURES];
+    GLuint opv[VEIL_MAX_OPV_TEXTURES];
 };
+
+/* ---- content keys (FNV-1a, 64 bit) ------------------------------------- */
+
+#define VEIL__FNV_OFFSET 0xcbf29ce484222325ull
+#define VEIL__FNV_PRIME 0x100000001b3ull
+
+static uint64_t hash_bytes(uint64_t h, const void* data, size_t n)
+{
+    const unsigned char* p = data;
+    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * VEIL__FNV_PRIME;
+    return h;
+}
+
+/* ---- lifetime ---------------------------------------------------------- */
 
 veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_error* err)
 {
@@ -22,9 +46,7 @@ veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_er
     r->memory_budget = veil_gl_get_info(gl)->memory_budget;
     veil_result res = veil_gl_compute_program("volume/shaders/inject_rbf.comp", veil_shader_inject_rbf_comp,
                                               &r->inject, err);
-    if (res == VEIL_OK)
-        res = veil_gl_compute_program("propagate/shaders/propagate_jacobi.comp",
-                                      veil_shader_propagate_jacobi_comp, &r->propagate, err);
+    if (res == VEIL_OK) res = veil_opv_programs_create(&r->opv_programs, err);
     if (res == VEIL_OK)
         res = veil_gl_compute_program("render/shaders/march.comp", veil_shader_march_comp, &r->march, err);
     if (res != VEIL_OK) {
@@ -35,17 +57,36 @@ veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_er
     return VEIL_OK;
 }
 
+static void drop_opvs(veil_renderer* r)
+{
+    glDeleteTextures(VEIL_MAX_OPV_TEXTURES, r->opv);
+    memset(r->opv, 0, sizeof r->opv);
+    memset(r->opv_key, 0, sizeof r->opv_key);
+}
+
+static void drop_volume(veil_renderer* r)
+{
+    glDeleteTextures(1, &r->ev);
+    r->ev = 0;
+    r->ev_key = 0;
+    r->has_volume = 0;
+    drop_opvs(r);
+}
+
 void veil_renderer_destroy(veil_renderer* r)
 {
     if (!r) return;
+    drop_volume(r);
     glDeleteProgram(r->inject);
-    glDeleteProgram(r->propagate);
     glDeleteProgram(r->march);
+    veil_opv_programs_destroy(&r->opv_programs);
     free(r);
 }
 
+/* ---- helpers ----------------------------------------------------------- */
+
 /* GPU bytes of the EV and the OPVs (plus the scratch ping-pong texture),
- * checked for overflow before anything is allocated. */
+ * checked for overflow and against the budget before anything is made. */
 static veil_result check_volume_size(const veil_renderer* r, const veil_grid* g, int n_lights, veil_error* err)
 {
     size_t n_tex = (size_t)(n_lights + 3) / 4, bytes_ev, bytes_opv;
@@ -63,26 +104,14 @@ static veil_result check_volume_size(const veil_renderer* r, const veil_grid* g,
     return VEIL_OK;
 }
 
-static veil_result upload_density(const veil_grid* g, const float* density, GLuint* tex, veil_error* err)
-{
-    veil_result r = veil_gl_texture3d(GL_R32F, g->dims, "veil extinction volume", tex, err);
-    if (r != VEIL_OK) return r;
-    glTextureSubImage3D(*tex, 0, 0, 0, 0, g->dims[0], g->dims[1], g->dims[2], GL_RED, GL_FLOAT, density);
-    return veil_gl_check("uploading the extinction volume", err);
-}
-
 static veil_result read_texture(GLuint tex, GLenum format, size_t floats, float* out, const char* what,
                                 veil_error* err)
 {
     size_t bytes = floats * sizeof(float);
-    if (bytes > (size_t)INT32_MAX) return veil_fail(err, VEIL_ERR_LIMIT, "%s: %zu bytes is too large to read back", what, bytes);
+    if (bytes > (size_t)INT32_MAX)
+        return veil_fail(err, VEIL_ERR_LIMIT, "%s: %zu bytes is too large to read back", what, bytes);
     glGetTextureImage(tex, 0, format, GL_FLOAT, (GLsizei)bytes, out);
     return veil_gl_check(what, err);
-}
-
-static void lights_to_index_space(const veil_scene* s, const veil_grid* g, veil_opv_light* out)
-{
-    for (size_t l = 0; l < s->light_count; ++l) veil_opv_light_from_world(g, &s->lights[l], &out[l]);
 }
 
 static float max_sigma_t(const veil_medium* m)
@@ -92,8 +121,108 @@ static float max_sigma_t(const veil_medium* m)
     return mx;
 }
 
-static void set_march_uniforms(GLuint p, const veil_scene* s, const veil_camera_basis* cam, int w, int h,
-                               const veil_grid* g, float step_voxels, uint32_t seed)
+/* Does light l add anything inside the box of g? Zero colour never does; a
+ * spot whose outer cone misses the box's bounding sphere does not. */
+static int light_reaches(const veil_light* l, const veil_grid* g)
+{
+    if (!(l->color[0] > 0.0f || l->color[1] > 0.0f || l->color[2] > 0.0f)) return 0;
+    if (l->type != VEIL_LIGHT_SPOT || l->outer_angle_deg >= 90.0f) return 1;
+    double c[3], d2 = 0.0, r2 = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        double half = 0.5 * g->dims[a] * (double)g->voxel;
+        c[a] = g->origin[a] + half - l->position[a];
+        d2 += c[a] * c[a];
+        r2 += half * half;
+    }
+    if (d2 <= r2) return 1; /* the light is within the sphere */
+    double cos_axis = (c[0] * l->direction[0] + c[1] * l->direction[1] + c[2] * l->direction[2]) / sqrt(d2);
+    double angle = acos(fmax(-1.0, fmin(1.0, cos_axis)));
+    double spread = l->outer_angle_deg * (VEIL_PI / 180.0) + asin(sqrt(r2 / d2));
+    return angle <= spread;
+}
+
+/* ---- stage 1: the extinction volume ------------------------------------ */
+
+static veil_result make_ev(veil_renderer* r, const veil_grid* g, uint64_t key, int n_lights, veil_error* err)
+{
+    drop_volume(r);
+    veil_result res = check_volume_size(r, g, n_lights, err);
+    if (res == VEIL_OK) res = veil_gl_texture3d(GL_R32F, g->dims, "veil extinction volume", &r->ev, err);
+    if (res != VEIL_OK) return res;
+    r->grid = *g;
+    r->has_volume = 1;
+    r->ev_key = key;
+    return VEIL_OK;
+}
+
+static veil_result inject_scene(veil_renderer* r, const veil_scene* s, veil_render_stats* st, veil_error* err)
+{
+    veil_particle* parts = NULL;
+    size_t n = 0;
+    veil_result res = veil_scene_particles(s, &parts, &n, err);
+    if (res != VEIL_OK) return res;
+    uint64_t key = hash_bytes(VEIL__FNV_OFFSET, &s->medium.max_resolution, sizeof s->medium.max_resolution);
+    key = hash_bytes(key, parts, n * sizeof *parts);
+    float lo[3], hi[3];
+    if (r->ev_key == key) {
+        st->inject_cached = 1;
+    } else if (!veil_rbf_bounds(parts, n, lo, hi)) {
+        drop_volume(r);
+        r->ev_key = key; /* an empty medium, remembered as such */
+        r->particles = n;
+    } else {
+        veil_grid g;
+        veil_rbf_bins bins = {0};
+        res = veil_grid_fit(lo, hi, s->medium.max_resolution, &g, err);
+        if (res == VEIL_OK) res = make_ev(r, &g, key, (int)s->light_count, err);
+        if (res == VEIL_OK) res = veil_rbf_bin(&g, parts, n, &bins, err);
+        if (res == VEIL_OK) res = veil_inject_rbf_gpu(r->inject, &g, &bins, r->ev, err);
+        if (res != VEIL_OK) drop_volume(r);
+        veil_rbf_bins_free(&bins);
+        r->particles = n;
+    }
+    free(parts);
+    return res;
+}
+
+/* ---- stage 2: optical depth -------------------------------------------- */
+
+static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_light* lights, int n,
+                             veil_opv_method method, veil_render_stats* st, veil_error* err)
+{
+    float st_max = max_sigma_t(&s->medium);
+    /* D changes of tol move tau by at most st_max * tol */
+    veil_opv_params params = {.method = method,
+                              .tolerance = st_max > 0.0f ? VEIL_OPV_TAU_TOLERANCE / st_max : INFINITY};
+    veil_result res = VEIL_OK;
+    for (int t = 0; 4 * t < n && res == VEIL_OK; ++t) {
+        int count = n - 4 * t < 4 ? n - 4 * t : 4;
+        veil_opv_light ol[4];
+        uint64_t key = hash_bytes(r->ev_key, &params, sizeof params);
+        for (int c = 0; c < count; ++c) {
+            veil_opv_light_from_world(&r->grid, &lights[4 * t + c], &ol[c]);
+            key = hash_bytes(key, &ol[c], sizeof ol[c]);
+        }
+        if (r->opv[t] && r->opv_key[t] == key) {
+            ++st->opv_cached;
+            continue;
+        }
+        if (!r->opv[t]) res = veil_gl_texture3d(GL_RGBA32F, r->grid.dims, "veil optical-depth volume", &r->opv[t], err);
+        int it = 0;
+        r->opv_key[t] = 0;
+        if (res == VEIL_OK) res = veil_opv_gpu(&r->opv_programs, &r->grid, r->ev, ol, count, &params, &r->opv[t], &it, err);
+        if (res == VEIL_OK) r->opv_key[t] = key;
+        st->propagate_iterations = it > st->propagate_iterations ? it : st->propagate_iterations;
+        ++st->opv_computed;
+    }
+    return res;
+}
+
+/* ---- stage 3: the march ------------------------------------------------- */
+
+static void set_march_uniforms(GLuint p, const veil_scene* s, const veil_light* lights, int n,
+                               const veil_camera_basis* cam, int w, int h, const veil_grid* g, float step_voxels,
+                               uint32_t seed)
 {
     glProgramUniform2i(p, glGetUniformLocation(p, "u_size"), w, h);
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_cam_pos"), 1, cam->pos);
@@ -109,74 +238,53 @@ static void set_march_uniforms(GLuint p, const veil_scene* s, const veil_camera_
     glProgramUniform1ui(p, glGetUniformLocation(p, "u_seed"), seed);
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_background"), 1, s->background);
     if (g) {
-        float hi[3];
-        for (int a = 0; a < 3; ++a) hi[a] = g->origin[a] + (float)g->dims[a] * g->voxel;
-        glProgramUniform3fv(p, glGetUniformLocation(p, "u_box_min"), 1, g->origin);
+        float lo[3], hi[3], inv[3];
+        veil_grid_medium_box(g, lo, hi);
+        for (int a = 0; a < 3; ++a) inv[a] = 1.0f / ((float)g->dims[a] * g->voxel);
+        glProgramUniform3fv(p, glGetUniformLocation(p, "u_box_min"), 1, lo);
         glProgramUniform3fv(p, glGetUniformLocation(p, "u_box_max"), 1, hi);
+        glProgramUniform3fv(p, glGetUniformLocation(p, "u_tex_min"), 1, g->origin);
+        glProgramUniform3fv(p, glGetUniformLocation(p, "u_tex_inv_size"), 1, inv);
         glProgramUniform1f(p, glGetUniformLocation(p, "u_step"), step_voxels * g->voxel);
         float md = VEIL_MIN_LIGHT_DISTANCE_VOXELS * g->voxel;
         glProgramUniform1f(p, glGetUniformLocation(p, "u_min_dist2"), md * md);
     }
-    int n = (int)s->light_count;
     GLint types[VEIL_MAX_LIGHTS] = {0};
     GLfloat pos[3 * VEIL_MAX_LIGHTS] = {0}, dir[3 * VEIL_MAX_LIGHTS] = {0}, col[3 * VEIL_MAX_LIGHTS] = {0};
+    GLfloat cone[2 * VEIL_MAX_LIGHTS] = {0};
     for (int l = 0; l < n; ++l) {
-        types[l] = s->lights[l].type;
-        memcpy(pos + 3 * l, s->lights[l].position, sizeof(float[3]));
-        memcpy(dir + 3 * l, s->lights[l].direction, sizeof(float[3]));
-        memcpy(col + 3 * l, s->lights[l].color, sizeof(float[3]));
+        types[l] = lights[l].type;
+        memcpy(pos + 3 * l, lights[l].position, sizeof(float[3]));
+        memcpy(dir + 3 * l, lights[l].direction, sizeof(float[3]));
+        memcpy(col + 3 * l, lights[l].color, sizeof(float[3]));
+        cone[2 * l] = cosf(lights[l].inner_angle_deg * (float)(VEIL_PI / 180.0));
+        cone[2 * l + 1] = cosf(lights[l].outer_angle_deg * (float)(VEIL_PI / 180.0));
     }
     glProgramUniform1i(p, glGetUniformLocation(p, "u_light_count"), n);
     glProgramUniform1iv(p, glGetUniformLocation(p, "u_light_type"), VEIL_MAX_LIGHTS, types);
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_light_pos"), VEIL_MAX_LIGHTS, pos);
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_light_dir"), VEIL_MAX_LIGHTS, dir);
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_light_color"), VEIL_MAX_LIGHTS, col);
+    glProgramUniform2fv(p, glGetUniformLocation(p, "u_light_cone"), VEIL_MAX_LIGHTS, cone);
     GLint units[VEIL_MAX_OPV_TEXTURES];
     for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) units[t] = VEIL_TEX_OPV0 + t;
     glProgramUniform1iv(p, glGetUniformLocation(p, "u_opv"), VEIL_MAX_OPV_TEXTURES, units);
 }
 
-/* Propagates (when there is a volume) and marches. ev may be 0 (no medium). */
-static veil_result propagate_and_march(veil_renderer* r, const veil_scene* s, const veil_grid* g, GLuint ev,
-                                       const veil_render_opts* o, float** rgba, veil_render_stats* st,
-                                       veil_error* err)
+static veil_result march(veil_renderer* r, const veil_scene* s, const veil_light* lights, int n,
+                         const veil_render_opts* o, int w, int h, float** rgba, veil_error* err)
 {
-    int w = o->width > 0 ? o->width : s->camera.width;
-    int h = o->height > 0 ? o->height : s->camera.height;
-    if (w < 1 || h < 1 || w > VEIL_SCENE_MAX_IMAGE || h > VEIL_SCENE_MAX_IMAGE)
-        return veil_fail(err, VEIL_ERR_INVALID, "image size %dx%d is outside 1..%d", w, h, VEIL_SCENE_MAX_IMAGE);
-    if (s->light_count > VEIL_MAX_LIGHTS)
-        return veil_fail(err, VEIL_ERR_LIMIT, "%zu lights; at most %d are supported", s->light_count, VEIL_MAX_LIGHTS);
     veil_camera_basis cam;
-    veil_result res = veil_camera_make_basis(&s->camera, w, h, &cam, err);
+    veil_result res = veil_camera_make_basis(o->camera ? o->camera : &s->camera, w, h, &cam, err);
     if (res != VEIL_OK) return res;
     size_t floats;
     if (!veil_mul_sizes((size_t)w, (size_t)h, 4, 1, &floats)) return veil_fail(err, VEIL_ERR_LIMIT, "image too large");
     float step = o->step_voxels > 0.0f ? o->step_voxels : VEIL_DEFAULT_STEP_VOXELS;
-
-    GLuint opv[VEIL_MAX_OPV_TEXTURES] = {0}, out_tex = 0;
-    int n_tex = ((int)s->light_count + 3) / 4;
-    double t0 = veil_now_ms();
-    if (ev) {
-        veil_opv_light lights[VEIL_MAX_LIGHTS];
-        lights_to_index_space(s, g, lights);
-        for (int t = 0; t < n_tex && res == VEIL_OK; ++t)
-            res = veil_gl_texture3d(GL_RGBA32F, g->dims, "veil optical-depth volume", &opv[t], err);
-        float st_max = max_sigma_t(&s->medium);
-        /* D changes of tol move tau by at most st_max * tol */
-        veil_opv_params params = {.tolerance = st_max > 0.0f ? VEIL_OPV_TAU_TOLERANCE / st_max : INFINITY};
-        if (res == VEIL_OK && n_tex > 0)
-            res = veil_opv_jacobi_gpu(r->propagate, g, ev, lights, (int)s->light_count, &params, opv,
-                                      &st->propagate_iterations, err);
-        glFinish();
-    }
-    double t1 = veil_now_ms();
-    if (res == VEIL_OK) {
-        glCreateTextures(GL_TEXTURE_2D, 1, &out_tex);
-        glTextureStorage2D(out_tex, 1, GL_RGBA32F, w, h);
-        glObjectLabel(GL_TEXTURE, out_tex, -1, "veil image");
-        res = veil_gl_check("allocating the output image", err);
-    }
+    GLuint out_tex = 0;
+    glCreateTextures(GL_TEXTURE_2D, 1, &out_tex);
+    glTextureStorage2D(out_tex, 1, GL_RGBA32F, w, h);
+    glObjectLabel(GL_TEXTURE, out_tex, -1, "veil image");
+    res = veil_gl_check("allocating the output image", err);
     if (res == VEIL_OK) {
         *rgba = malloc(floats * sizeof(float));
         if (!*rgba) res = veil_fail(err, VEIL_ERR_OOM, "out of memory for a %dx%d image", w, h);
@@ -184,9 +292,9 @@ static veil_result propagate_and_march(veil_renderer* r, const veil_scene* s, co
     if (res == VEIL_OK) {
         GLuint p = r->march;
         glUseProgram(p);
-        set_march_uniforms(p, s, &cam, w, h, ev ? g : NULL, step, o->seed);
-        glBindTextureUnit(VEIL_TEX_EV, ev);
-        for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, opv[t]);
+        set_march_uniforms(p, s, lights, n, &cam, w, h, r->has_volume ? &r->grid : NULL, step, o->seed);
+        glBindTextureUnit(VEIL_TEX_EV, r->ev);
+        for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, r->opv[t]);
         glBindImageTexture(VEIL_IMAGE_OUT, out_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glDispatchCompute(veil_groups(w, VEIL_MARCH_GROUP), veil_groups(h, VEIL_MARCH_GROUP), 1);
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
@@ -200,13 +308,44 @@ static veil_result propagate_and_march(veil_renderer* r, const veil_scene* s, co
             *rgba = NULL;
         }
     }
-    double t2 = veil_now_ms();
     glDeleteTextures(1, &out_tex);
-    glDeleteTextures(VEIL_MAX_OPV_TEXTURES, opv);
-    st->propagate_ms = t1 - t0;
-    st->render_ms = t2 - t1;
     return res;
 }
+
+/* Propagates and marches once the EV is in place (or known empty). */
+static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const veil_render_opts* o, float** rgba,
+                                   veil_render_stats* st, veil_error* err)
+{
+    const veil_camera* camera = o->camera ? o->camera : &s->camera;
+    int w = o->width > 0 ? o->width : camera->width;
+    int h = o->height > 0 ? o->height : camera->height;
+    if (w < 1 || h < 1 || w > VEIL_SCENE_MAX_IMAGE || h > VEIL_SCENE_MAX_IMAGE)
+        return veil_fail(err, VEIL_ERR_INVALID, "image size %dx%d is outside 1..%d", w, h, VEIL_SCENE_MAX_IMAGE);
+    if (s->light_count > VEIL_MAX_LIGHTS)
+        return veil_fail(err, VEIL_ERR_LIMIT, "%zu lights; at most %d are supported", s->light_count, VEIL_MAX_LIGHTS);
+    veil_light lights[VEIL_MAX_LIGHTS];
+    int n = 0;
+    for (size_t l = 0; l < s->light_count && r->has_volume; ++l)
+        if (light_reaches(&s->lights[l], &r->grid)) lights[n++] = s->lights[l];
+    st->lights_used = n;
+    st->method = veil_opv_method_resolve(o->method);
+    st->has_volume = r->has_volume;
+    st->grid = r->grid;
+    st->particles = r->particles;
+    veil_result res = VEIL_OK;
+    double t0 = veil_now_ms();
+    if (n > 0) {
+        res = propagate(r, s, lights, n, st->method, st, err);
+        glFinish();
+    }
+    double t1 = veil_now_ms();
+    if (res == VEIL_OK) res = march(r, s, lights, n, o, w, h, rgba, err);
+    st->propagate_ms = t1 - t0;
+    st->render_ms = veil_now_ms() - t1;
+    return res;
+}
+
+/* ---- public entry points ------------------------------------------------ */
 
 veil_result veil_render_density(veil_renderer* r, const veil_scene* s, const veil_grid* g, const float* density,
                                 const veil_render_opts* opts, float** rgba, veil_render_stats* stats,
@@ -215,16 +354,24 @@ veil_result veil_render_density(veil_renderer* r, const veil_scene* s, const vei
     veil_render_opts o = opts ? *opts : (veil_render_opts){0};
     veil_render_stats st = {0};
     *rgba = NULL;
-    GLuint ev = 0;
-    veil_result res = check_volume_size(r, g, (int)s->light_count, err);
     double t0 = veil_now_ms();
-    if (res == VEIL_OK) res = upload_density(g, density, &ev, err);
+    uint64_t key = hash_bytes(VEIL__FNV_OFFSET, g, sizeof *g);
+    key = hash_bytes(key, density, veil_grid_voxels(g) * sizeof(float));
+    veil_result res = VEIL_OK;
+    if (r->has_volume && r->ev_key == key) {
+        st.inject_cached = 1;
+    } else {
+        res = make_ev(r, g, key, (int)s->light_count, err);
+        if (res == VEIL_OK) {
+            glTextureSubImage3D(r->ev, 0, 0, 0, 0, g->dims[0], g->dims[1], g->dims[2], GL_RED, GL_FLOAT, density);
+            res = veil_gl_check("uploading the extinction volume", err);
+        }
+        if (res != VEIL_OK) drop_volume(r);
+        r->particles = 0;
+    }
     glFinish();
     st.inject_ms = veil_now_ms() - t0;
-    st.has_volume = 1;
-    st.grid = *g;
-    if (res == VEIL_OK) res = propagate_and_march(r, s, g, ev, &o, rgba, &st, err);
-    glDeleteTextures(1, &ev);
+    if (res == VEIL_OK) res = light_and_march(r, s, &o, rgba, &st, err);
     if (stats) *stats = st;
     return res;
 }
@@ -236,29 +383,10 @@ veil_result veil_render_scene(veil_renderer* r, const veil_scene* s, const veil_
     veil_render_stats st = {0};
     *rgba = NULL;
     double t0 = veil_now_ms();
-    veil_particle* parts = NULL;
-    size_t n = 0;
-    veil_result res = veil_scene_particles(s, &parts, &n, err);
-    float lo[3], hi[3];
-    veil_grid g;
-    veil_rbf_bins bins = {0};
-    GLuint ev = 0;
-    st.particles = n;
-    st.has_volume = res == VEIL_OK && veil_rbf_bounds(parts, n, lo, hi);
-    if (res == VEIL_OK && st.has_volume) {
-        res = veil_grid_fit(lo, hi, s->medium.max_resolution, &g, err);
-        if (res == VEIL_OK) res = check_volume_size(r, &g, (int)s->light_count, err);
-        if (res == VEIL_OK) res = veil_rbf_bin(&g, parts, n, &bins, err);
-        if (res == VEIL_OK) res = veil_gl_texture3d(GL_R32F, g.dims, "veil extinction volume", &ev, err);
-        if (res == VEIL_OK) res = veil_inject_rbf_gpu(r->inject, &g, &bins, ev, err);
-        glFinish();
-        st.grid = g;
-    }
-    free(parts);
-    veil_rbf_bins_free(&bins);
+    veil_result res = inject_scene(r, s, &st, err);
+    glFinish();
     st.inject_ms = veil_now_ms() - t0;
-    if (res == VEIL_OK) res = propagate_and_march(r, s, st.has_volume ? &g : NULL, ev, &o, rgba, &st, err);
-    glDeleteTextures(1, &ev);
+    if (res == VEIL_OK) res = light_and_march(r, s, &o, rgba, &st, err);
     if (stats) *stats = st;
     return res;
 }
@@ -287,10 +415,15 @@ veil_result veil_renderer_propagate(veil_renderer* r, const veil_grid* g, const 
     int n_tex = (n_lights + 3) / 4;
     size_t nv = veil_grid_voxels(g);
     float* tmp = malloc(nv * 4 * sizeof(float));
-    veil_result res = tmp ? upload_density(g, density, &ev, err) : veil_fail(err, VEIL_ERR_OOM, "out of memory");
+    veil_result res = tmp ? veil_gl_texture3d(GL_R32F, g->dims, "veil extinction volume", &ev, err)
+                          : veil_fail(err, VEIL_ERR_OOM, "out of memory");
+    if (res == VEIL_OK) {
+        glTextureSubImage3D(ev, 0, 0, 0, 0, g->dims[0], g->dims[1], g->dims[2], GL_RED, GL_FLOAT, density);
+        res = veil_gl_check("uploading the extinction volume", err);
+    }
     for (int t = 0; t < n_tex && res == VEIL_OK; ++t)
         res = veil_gl_texture3d(GL_RGBA32F, g->dims, "veil optical-depth volume", &opv[t], err);
-    if (res == VEIL_OK) res = veil_opv_jacobi_gpu(r->propagate, g, ev, lights, n_lights, params, opv, iterations, err);
+    if (res == VEIL_OK) res = veil_opv_gpu(&r->opv_programs, g, ev, lights, n_lights, params, opv, iterations, err);
     for (int t = 0; t < n_tex && res == VEIL_OK; ++t) {
         res = read_texture(opv[t], GL_RGBA, nv * 4, tmp, "reading back an OPV", err);
         for (int c = 0; c < 4 && 4 * t + c < n_lights && res == VEIL_OK; ++c)

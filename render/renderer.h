@@ -7,6 +7,15 @@
  * A renderer owns its compute programs and needs the veil_gl context that
  * was current when it was created. Images are returned as newly malloc'd
  * float RGBA, top row first (free() them).
+ *
+ * Work a frame does not need is skipped: the EV is kept with a key of the
+ * content it was made from (resolution and particles, or the given
+ * density), and each OPV texture with a key of the EV, the method and its
+ * lights' positions; a later render whose inputs have the same keys (a
+ * turntable: only the camera moves) reuses them, and the stats say
+ * "cached". Lights that add nothing (zero colour, or a spot whose cone
+ * misses the volume) get no OPV and are not marched; an empty medium
+ * makes no EV and no OPV.
  */
 #ifndef VEIL_RENDERER_H
 #define VEIL_RENDERER_H
@@ -34,17 +43,23 @@
 typedef struct veil_renderer veil_renderer;
 
 typedef struct veil_render_opts {
-    int width, height;  /* 0: the scene camera's */
-    float step_voxels;  /* 0: VEIL_DEFAULT_STEP_VOXELS */
-    uint32_t seed;      /* jitter seed */
+    int width, height;      /* 0: the scene camera's */
+    float step_voxels;      /* 0: VEIL_DEFAULT_STEP_VOXELS */
+    uint32_t seed;          /* jitter seed */
+    veil_opv_method method; /* 0: VEIL_OPV_DEFAULT_METHOD */
+    const veil_camera* camera; /* NULL: the scene's (turntables move it) */
 } veil_render_opts;
 
 typedef struct veil_render_stats {
     double inject_ms, propagate_ms, render_ms; /* wall time, GPU work finished */
     int has_volume;       /* 0: nothing to inject (empty medium) */
+    int inject_cached;    /* the EV was reused */
     veil_grid grid;       /* the EV's geometry when has_volume */
     size_t particles;
-    int propagate_iterations;
+    int lights_used;      /* lights that reach the volume and add light */
+    int opv_computed, opv_cached; /* OPV textures made / reused */
+    veil_opv_method method;
+    int propagate_iterations; /* Jacobi steps or sweep passes (most of any light) */
 } veil_render_stats;
 
 veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_error* err);

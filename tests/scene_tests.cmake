@@ -38,3 +38,7 @@ veil_bad_input(volume_too_large ${BAD}/volume_too_large.json
                "volume_too_large.json: a 2048x2048x2048 extinction volume with 16 lights needs")
 veil_bad_input(missing_file ${BAD}/does_not_exist.json "does_not_exist.json: cannot open: No such file or directory")
 veil_bad_input(directory ${BAD} "bad: cannot read: Is a directory")
+veil_bad_input(spot_inner_ge_outer ${BAD}/spot_inner_ge_outer.json
+               "spot_inner_ge_outer.json: lights[1].inner_angle_deg: expected a number of degrees in [0, outer_angle_deg) = [0, 25), got 40")
+veil_bad_input(spot_missing_outer ${BAD}/spot_missing_outer.json
+               "spot_missing_outer.json: lights[0].outer_angle_deg: missing required field (a number of degrees in (0, 180])")

@@ -32,10 +32,10 @@ int main(void)
     veil_opv_light_from_world(&g, &light, &L);
     CHECK(fabsf(L.v[0] - C) < 1e-5f, "light index position %g", L.v[0]);
 
-    veil_opv_params exact = {0};
+    veil_opv_params exact = {.method = VEIL_OPV_JACOBI};
     int iters = 0;
     veil_error err = {0};
-    CHECK(veil_opv_jacobi_cpu(&g, rho, &L, 1, &exact, D, &iters, &err) == VEIL_OK, "%s", err.msg);
+    CHECK(veil_opv_cpu(&g, rho, &L, 1, &exact, D, &iters, &err) == VEIL_OK, "%s", err.msg);
 
     int bad_axis = 0, bad_l1 = 0;
     double se = 0.0;
@@ -66,10 +66,10 @@ int main(void)
 
     /* With the renderer's tolerance (tau changes < 1e-4 for sigma_t = 1) it
      * stops no later than the exact run, and within that tolerance of it. */
-    veil_opv_params tol = {.tolerance = 1e-4f};
+    veil_opv_params tol = {.method = VEIL_OPV_JACOBI, .tolerance = 1e-4f};
     float* D2 = malloc(nv * sizeof(float));
     int iters2 = 0;
-    veil_opv_jacobi_cpu(&g, rho, &L, 1, &tol, D2, &iters2, &err);
+    veil_opv_cpu(&g, rho, &L, 1, &tol, D2, &iters2, &err);
     double worst = 0.0;
     for (size_t v = 0; v < nv; ++v) worst = fmax(worst, fabs(D2[v] - D[v]));
     printf("  with tolerance 1e-4: %d iterations, largest difference from the fixed point %.3g\n", iters2, worst);

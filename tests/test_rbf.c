@@ -52,11 +52,16 @@ static void test_grid_fit(void)
     veil_grid g;
     veil_error err = {0};
     CHECK(veil_grid_fit(lo, hi, 64, &g, &err) == VEIL_OK, "%s", err.msg);
-    CHECK(g.dims[0] == 64 && g.dims[1] == 16 && g.dims[2] == 32, "dims %d %d %d", g.dims[0], g.dims[1], g.dims[2]);
-    CHECK(check_close(g.voxel, 4.0 / 64, 0, 1e-6), "voxel %g", g.voxel);
+    /* 64 centres span the longest side (63 gaps of 4/63); the others need
+     * ceil(1 / (4/63)) + 1 = 17 and ceil(2 / (4/63)) + 1 = 33 */
+    CHECK(g.dims[0] == 64 && g.dims[1] == 17 && g.dims[2] == 33, "dims %d %d %d", g.dims[0], g.dims[1], g.dims[2]);
+    CHECK(check_close(g.voxel, 4.0 / 63, 0, 1e-6), "voxel %g", g.voxel);
+    float mlo[3], mhi[3];
+    veil_grid_medium_box(&g, mlo, mhi);
     for (int a = 0; a < 3; ++a) {
-        CHECK(g.origin[a] <= lo[a] + 1e-6f, "box does not cover lo on axis %d", a);
-        CHECK(g.origin[a] + g.dims[a] * g.voxel >= hi[a] - 1e-6f, "box does not cover hi on axis %d", a);
+        CHECK(mlo[a] <= lo[a] + 1e-6f, "the centres do not cover lo on axis %d", a);
+        CHECK(mhi[a] >= hi[a] - 1e-6f, "the centres do not cover hi on axis %d", a);
+        CHECK(mhi[a] - mlo[a] < hi[a] - lo[a] + g.voxel, "the span exceeds the box by a voxel on axis %d", a);
     }
     float zlo[3] = {0, 0, 0};
     CHECK(veil_grid_fit(zlo, zlo, 64, &g, &err) == VEIL_ERR_INVALID, "zero box accepted");

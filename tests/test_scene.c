@@ -34,6 +34,9 @@ static int vec_close(const float* v, double x, double y, double z)
 #define MED "'medium':{'sigma_s':[1,1,1],'sources':[]}"
 #define LIGHT_OK "{'type':'point','position':[0,0,0],'intensity':[1,1,1]}"
 #define SRC_OK "{'type':'rbf','particles':[]}"
+#define LIGHTS(l) "{" CAM "," MED ",'lights':[" l "]}"
+#define SPOT(f) LIGHTS("{'type':'spot','position':[0,0,0]," f "}")
+#define SPOT_DI "'direction':[0,0,1],'intensity':[1,1,1],"
 #define RND(f) "{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'rbf_random'," f "}]}}"
 #define RND_OK_COUNT "'count':3,'seed':1,"
 #define RND_OK_BOUNDS "'bounds':[[0,0,0],[1,1,1]],"
@@ -242,12 +245,45 @@ static const bad_case BAD[] = {
      VEIL_ERR_INVALID, "lights[1].intensity", "expected an array of 3 numbers >= 0, got a string (\"red\")"},
     {"{" CAM "," MED ",'lights':[{'type':'directional','direction':[0,0,0],'irradiance':[1,1,1]}]}",
      VEIL_ERR_INVALID, "lights[0].direction", "expected a non-zero vector"},
-    {"{" CAM "," MED ",'lights':[{'type':'spot','position':[0,0,0],'intensity':[1,1,1]}]}",
-     VEIL_ERR_INVALID, "lights[0].type", "expected one of \"point\", \"directional\", got a string"},
+    {"{" CAM "," MED ",'lights':[{'type':'area','position':[0,0,0],'intensity':[1,1,1]}]}",
+     VEIL_ERR_INVALID, "lights[0].type", "expected one of \"point\", \"directional\", \"spot\", got a string"},
     {"{" CAM "," MED ",'lights':[{'type':'point','direction':[0,0,1],'intensity':[1,1,1]}]}",
      VEIL_ERR_INVALID, "lights[0].direction", "unknown key (expected one of: type, position, intensity)"},
     {"{" CAM "," MED ",'lights':[{'type':'directional','direction':[0,0,1]}]}", VEIL_ERR_INVALID,
      "lights[0].irradiance", "missing required field"},
+    /* spot lights */
+    {SPOT(SPOT_DI "'inner_angle_deg':45,'outer_angle_deg':30"), VEIL_ERR_INVALID, "lights[0].inner_angle_deg",
+     "expected a number of degrees in [0, outer_angle_deg) = [0, 30), got 45"},
+    {SPOT(SPOT_DI "'inner_angle_deg':30,'outer_angle_deg':30"), VEIL_ERR_INVALID, "lights[0].inner_angle_deg",
+     "expected a number of degrees in [0, outer_angle_deg) = [0, 30), got 30"},
+    {SPOT(SPOT_DI "'inner_angle_deg':-5,'outer_angle_deg':30"), VEIL_ERR_INVALID, "lights[0].inner_angle_deg",
+     "expected a number of degrees in [0, outer_angle_deg) = [0, 30), got -5"},
+    {SPOT(SPOT_DI "'inner_angle_deg':'wide','outer_angle_deg':30"), VEIL_ERR_INVALID,
+     "lights[0].inner_angle_deg", "got a string (\"wide\")"},
+    {SPOT(SPOT_DI "'outer_angle_deg':190"), VEIL_ERR_INVALID, "lights[0].outer_angle_deg",
+     "expected a number of degrees in (0, 180], got 190"},
+    {SPOT(SPOT_DI "'outer_angle_deg':180.00001"), VEIL_ERR_INVALID, "lights[0].outer_angle_deg",
+     "expected a number of degrees in (0, 180], got 180.00001"},
+    {SPOT(SPOT_DI "'outer_angle_deg':0"), VEIL_ERR_INVALID, "lights[0].outer_angle_deg",
+     "expected a number of degrees in (0, 180], got 0 (negative and zero values are not allowed)"},
+    {SPOT(SPOT_DI "'inner_angle_deg':10"), VEIL_ERR_INVALID, "lights[0].outer_angle_deg",
+     "missing required field (a number of degrees in (0, 180])"},
+    {SPOT("'direction':[0,0,0],'intensity':[1,1,1],'outer_angle_deg':30"), VEIL_ERR_INVALID,
+     "lights[0].direction", "expected a non-zero vector (the direction light travels), got [0, 0, 0]"},
+    {SPOT("'intensity':[1,1,1],'outer_angle_deg':30"), VEIL_ERR_INVALID, "lights[0].direction",
+     "missing required field (an array of 3 numbers)"},
+    {SPOT(SPOT_DI "'outer_angle_deg':30,'irradiance':[1,1,1]"), VEIL_ERR_INVALID, "lights[0].irradiance",
+     "unknown key (expected one of: type, position, direction, intensity, inner_angle_deg, outer_angle_deg)"},
+    {LIGHTS("{'type':'spot','direction':[0,0,1],'intensity':[1,1,1],'outer_angle_deg':30}"), VEIL_ERR_INVALID,
+     "lights[0].position", "missing required field (an array of 3 numbers)"},
+    {SPOT("'direction':[0,0,1],'intensity':[1,-1,1],'outer_angle_deg':30"), VEIL_ERR_INVALID,
+     "lights[0].intensity[1]", "expected a number >= 0, got -1"},
+    {LIGHTS(LIGHT_OK ",{'type':'point','position':[0,0,0],'intensity':[1,1,1],'inner_angle_deg':10}"),
+     VEIL_ERR_INVALID, "lights[1].inner_angle_deg", "unknown key (expected one of: type, position, intensity)"},
+    {LIGHTS("{'type':'point','position':[0,0,0],'intensity':[1,1,1],'outer_angle_deg':30}"), VEIL_ERR_INVALID,
+     "lights[0].outer_angle_deg", "unknown key (expected one of: type, position, intensity)"},
+    {LIGHTS("{'type':'directional','direction':[0,0,1],'irradiance':[1,1,1],'outer_angle_deg':30}"),
+     VEIL_ERR_INVALID, "lights[0].outer_angle_deg", "unknown key (expected one of: type, direction, irradiance)"},
     {"{" CAM "," MED ",'background':{'colour':[1,1,1]}}", VEIL_ERR_INVALID, "background.colour",
      "unknown key (expected one of: color)"},
     {"{" CAM "," MED ",'background':{'color':[1,1,true]}}", VEIL_ERR_INVALID, "background.color[2]",
@@ -276,10 +312,50 @@ static void test_bad(void)
     }
 }
 
+static void test_spot(void)
+{
+    veil_scene s;
+    veil_error e = {0};
+    veil_result r = parse("spot.json", LIGHTS(LIGHT_OK ",{'type':'spot','position':[1,2,3],'direction':[0,-3,4],"
+                          "'intensity':[10,20,30],'inner_angle_deg':12.5,'outer_angle_deg':30},"
+                          "{'type':'spot','position':[0,0,0],'direction':[0,0,-0.001],'intensity':[0,0,0],"
+                          "'outer_angle_deg':180},{'type':'spot','outer_angle_deg':1e-3,'inner_angle_deg':0,"
+                          "'position':[0,0,0],'intensity':[1,1,1],'direction':[2,0,0]}"), &s, &e);
+    CHECK(r == VEIL_OK, "spot lights: %s", e.msg);
+    if (r != VEIL_OK) return;
+    CHECK(s.light_count == 4, "light_count %zu", s.light_count);
+    if (s.light_count == 4) {
+        const veil_light* l = s.lights;
+        CHECK(l[0].type == VEIL_LIGHT_POINT && l[0].inner_angle_deg == 0 && l[0].outer_angle_deg == 0,
+              "point light has no cone");
+        CHECK(l[1].type == VEIL_LIGHT_SPOT, "type %d", l[1].type);
+        CHECK(vec_close(l[1].position, 1, 2, 3), "spot position");
+        CHECK(vec_close(l[1].direction, 0, -0.6, 0.8), "spot direction not normalised: %g %g %g",
+              l[1].direction[0], l[1].direction[1], l[1].direction[2]);
+        CHECK(vec_close(l[1].color, 10, 20, 30), "spot intensity");
+        CHECK(l[1].inner_angle_deg == 12.5f && l[1].outer_angle_deg == 30.0f, "spot angles %g %g",
+              l[1].inner_angle_deg, l[1].outer_angle_deg);
+        CHECK(l[2].type == VEIL_LIGHT_SPOT && vec_close(l[2].direction, 0, 0, -1), "tiny axis normalised");
+        CHECK(l[2].inner_angle_deg == 0 && l[2].outer_angle_deg == 180.0f, "default inner 0, outer 180: %g %g",
+              l[2].inner_angle_deg, l[2].outer_angle_deg);
+        CHECK(vec_close(l[2].color, 0, 0, 0), "zero intensity is allowed");
+        CHECK(l[3].type == VEIL_LIGHT_SPOT && vec_close(l[3].direction, 1, 0, 0) &&
+              l[3].inner_angle_deg == 0 && l[3].outer_angle_deg == 1e-3f, "narrow spot, keys in any order");
+    }
+    veil_scene_free(&s);
+}
+
 static void test_exact_messages(void)
 {
     veil_scene s;
     veil_error e = {0};
+    parse("demo.json", LIGHTS(LIGHT_OK "," LIGHT_OK ",{'type':'spot','position':[0,0,0]," SPOT_DI
+          "'inner_angle_deg':45,'outer_angle_deg':30}"), &s, &e);
+    CHECK(strcmp(e.msg, "demo.json: lights[2].inner_angle_deg: expected a number of degrees in "
+                        "[0, outer_angle_deg) = [0, 30), got 45") == 0, "%s", e.msg);
+    parse("demo.json", SPOT(SPOT_DI "'inner_angle_deg':5"), &s, &e);
+    CHECK(strcmp(e.msg, "demo.json: lights[0].outer_angle_deg: missing required field "
+                        "(a number of degrees in (0, 180])") == 0, "%s", e.msg);
     parse("scene.json", "{'camera':{'position':[0,0,1],'look_at':[0,0,0],'fov':40}," MED "}", &s, &e);
     CHECK(strcmp(e.msg, "scene.json: camera.fov: unknown key (expected one of: position, look_at, up, "
                         "fov_y_deg, width, height)") == 0, "%s", e.msg);
@@ -368,6 +444,7 @@ int main(void)
     test_full();
     test_defaults();
     test_bad();
+    test_spot();
     test_exact_messages();
     test_syntax();
     test_load();

@@ -7,9 +7,10 @@
  * with D the ray's chord through the box.
  *
  * Why the GPU marcher should meet it to rounding: h is chosen at a voxel
- * centre, where the Jacobi optical depth of an axis-aligned directional
- * light is exact (the top voxel holds h/2 of density, each step down adds
- * one voxel, see propagate/opv.h) and the texture is read at a texel centre;
+ * centre, where the optical depth of an axis-aligned directional light is
+ * exact for every propagation method (the top voxels lie on the medium's
+ * face, D = 0, and each voxel down adds one voxel of density) and the
+ * texture is read at a texel centre;
  * the medium is constant, and each step integrates its in-scattering in
  * closed form, so the step size introduces no error here. What remains is
  * float rounding: per step a few operations of about 1 ulp and exp() within
@@ -31,12 +32,13 @@ int main(void)
     veil_error err = {0};
     CHECK(veil_renderer_create(gl, &r, &err) == VEIL_OK, "%s", err.msg);
 
-    enum { N = 16, W = 33, H = 33 };
+    /* 17 voxel centres per axis at 0, 1/16, ..., 1: the medium is [0,1]^3 */
+    enum { N = 17, W = 33, H = 33 };
     const int row_voxel = 9; /* the camera's height is this voxel row's centre */
-    veil_grid g = {.dims = {N, N, N}, .origin = {0, 0, 0}, .voxel = 1.0f / N};
+    veil_grid g = {.dims = {N, N, N}, .origin = {-0.5f / 16, -0.5f / 16, -0.5f / 16}, .voxel = 1.0f / 16};
     float* rho = malloc(N * N * N * sizeof(float));
     for (int v = 0; v < N * N * N; ++v) rho[v] = 1.0f;
-    const float y = (row_voxel + 0.5f) / N, depth = 1.0f - y;
+    const float y = row_voxel / 16.0f, depth = 1.0f - y;
 
     veil_light sun = {.type = VEIL_LIGHT_DIRECTIONAL, .direction = {0, -1, 0}, .color = {1.0f, 2.0f, 3.0f}};
     veil_scene s = {0};

@@ -7,8 +7,8 @@
 veil_result veil_grid_fit(const float lo[3], const float hi[3], int max_resolution,
                           veil_grid* out, veil_error* err)
 {
-    if (max_resolution < 1)
-        return veil_fail(err, VEIL_ERR_INVALID, "max_resolution must be >= 1, got %d", max_resolution);
+    if (max_resolution < 2)
+        return veil_fail(err, VEIL_ERR_INVALID, "max_resolution must be >= 2, got %d", max_resolution);
     float ext[3], longest = 0.0f;
     for (int k = 0; k < 3; ++k) {
         if (!isfinite(lo[k]) || !isfinite(hi[k]) || hi[k] < lo[k])
@@ -18,16 +18,25 @@ veil_result veil_grid_fit(const float lo[3], const float hi[3], int max_resoluti
     }
     if (!(longest > 0.0f) || !isfinite(longest))
         return veil_fail(err, VEIL_ERR_INVALID, "volume bounds have zero or infinite size");
-    out->voxel = longest / (float)max_resolution;
+    /* max_resolution centres span the longest side: max_resolution - 1 gaps */
+    out->voxel = longest / (float)(max_resolution - 1);
     for (int k = 0; k < 3; ++k) {
-        int n = (int)ceilf(ext[k] / out->voxel - 1e-4f); /* tolerate rounding up by 1e-4 voxel */
-        if (n < 1) n = 1;
+        int n = (int)ceilf(ext[k] / out->voxel - 1e-4f) + 1; /* tolerate rounding up by 1e-4 voxel */
+        if (n < 2) n = 2;
         if (n > max_resolution) n = max_resolution;
         out->dims[k] = n;
         float centre = 0.5f * (lo[k] + hi[k]);
         out->origin[k] = centre - 0.5f * (float)n * out->voxel;
     }
     return VEIL_OK;
+}
+
+void veil_grid_medium_box(const veil_grid* g, float lo[3], float hi[3])
+{
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = g->origin[a] + 0.5f * g->voxel;
+        hi[a] = g->origin[a] + ((float)g->dims[a] - 0.5f) * g->voxel;
+    }
 }
 
 size_t veil_grid_voxels(const veil_grid* g)

@@ -1,13 +1,15 @@
 /* veil — the extinction volume (EV): a dense grid of density over a
  * world-space box, and the RBF splat that fills it.
  *
- * Geometry: cubic voxels of edge `voxel` (m); voxel (i,j,k) covers
- * origin + [i, i+1) * voxel (likewise j, k) and its value is the density at
- * its centre origin + (i + 0.5) * voxel. Between centres the medium is the
- * trilinear interpolation of the values; inside the box and outside the
- * outermost centres it is held constant (clamp to edge); outside the box
- * there is no medium. Values are unitless density: extinction is
- * sigma_t = (sigma_a + sigma_s) * density, per colour channel, in m^-1.
+ * Geometry: cubic voxels of edge `voxel` (m); voxel (i,j,k) holds the
+ * density at its centre origin + (i + 0.5) * voxel (likewise j, k). The
+ * medium is the trilinear interpolation of these samples over the box they
+ * span, from the first centre to the last, and there is no medium outside
+ * it (the OpenVDB convention: values are samples at voxel centres). So a
+ * ray that leaves the centres' box has left the medium, and every voxel on
+ * the box's faces is on the medium's boundary. Values are unitless density:
+ * extinction is sigma_t = (sigma_a + sigma_s) * density, per colour
+ * channel, in m^-1.
  *
  * The splat is particles x footprint, not particles x grid: particles are
  * binned into VEIL_BRICK^3 bricks that their cut-off ball touches, and each
@@ -29,12 +31,15 @@ typedef struct veil_grid {
     float voxel;      /* voxel edge (m), > 0 */
 } veil_grid;
 
-/* Fits a grid to the box [lo, hi] with `max_resolution` voxels along its
- * longest side (centred, so the box grows by less than a voxel). */
+/* Fits a grid whose voxel centres span the box [lo, hi], with
+ * `max_resolution` (>= 2) voxels along its longest side (centred, so the
+ * span exceeds the box by less than a voxel). */
 veil_result veil_grid_fit(const float lo[3], const float hi[3], int max_resolution,
                           veil_grid* out, veil_error* err);
 
 size_t veil_grid_voxels(const veil_grid* g);
+/* The medium's box: from the first voxel centre to the last (m). */
+void veil_grid_medium_box(const veil_grid* g, float lo[3], float hi[3]);
 /* World position of voxel (i, j, k)'s centre, computed as the shaders do. */
 void veil_grid_center(const veil_grid* g, int i, int j, int k, float out[3]);
 

@@ -8,7 +8,8 @@
 //   L += T * sigma_s * L_in * (1 - exp(-sigma_t dt)) / sigma_t
 //   T *= exp(-sigma_t dt)
 // L_in sums the lights: radiance reaching X, exp(-sigma_t D(X,S)) times
-// I/|S-X|^2 (point) or E (directional), times the phase function.
+// I/|S-X|^2 (point; spot: times its cone falloff) or E (directional),
+// times the phase function.
 // Output: rgb = L + T * background, a = 1 - mean(T).
 layout(local_size_x = VEIL_MARCH_GROUP, local_size_y = VEIL_MARCH_GROUP) in;
 
@@ -19,7 +20,8 @@ uniform sampler3D u_opv[VEIL_MAX_OPV_TEXTURES];
 uniform ivec2 u_size;
 uniform vec3 u_cam_pos, u_cam_fwd, u_cam_right, u_cam_up; // right/up scaled by tan(fov/2) (and aspect)
 uniform int u_has_volume;
-uniform vec3 u_box_min, u_box_max;
+uniform vec3 u_box_min, u_box_max;   // the medium: from the first voxel centre to the last (m)
+uniform vec3 u_tex_min, u_tex_inv_size; // texture coordinates: (x - u_tex_min) * u_tex_inv_size
 uniform vec3 u_sigma_t, u_sigma_s;  // m^-1 per unit density
 uniform float u_g;                  // HG asymmetry (0: isotropic)
 uniform float u_step;               // m
@@ -28,8 +30,9 @@ uniform uint u_seed;
 uniform vec3 u_background;
 uniform int u_light_count;
 uniform int u_light_type[VEIL_MAX_LIGHTS];
-uniform vec3 u_light_pos[VEIL_MAX_LIGHTS];   // point: position (m)
-uniform vec3 u_light_dir[VEIL_MAX_LIGHTS];   // directional: unit travel direction
+uniform vec3 u_light_pos[VEIL_MAX_LIGHTS];   // point, spot: position (m)
+uniform vec3 u_light_dir[VEIL_MAX_LIGHTS];   // directional: unit travel direction; spot: its axis
+uniform vec2 u_light_cone[VEIL_MAX_LIGHTS];  // spot: cos(inner angle), cos(outer angle)
 uniform vec3 u_light_color[VEIL_MAX_LIGHTS]; // W/sr or W/m^2
 
 uint hash32(uint x)
@@ -57,11 +60,13 @@ vec3 in_scattered(vec3 x, vec3 uvw, vec3 dir)
     for (int l = 0; l < u_light_count; ++l) {
         float D = texture(u_opv[l / 4], uvw)[l % 4];
         vec3 travel, E;
-        if (u_light_type[l] == VEIL_LIGHT_POINT) {
+        if (u_light_type[l] != VEIL_LIGHT_DIRECTIONAL) {
             vec3 to_light = u_light_pos[l] - x;
             float r2 = max(dot(to_light, to_light), u_min_dist2);
             travel = -to_light * inversesqrt(r2);
             E = u_light_color[l] / r2;
+            if (u_light_type[l] == VEIL_LIGHT_SPOT)
+                E *= veil_spot_falloff(dot(travel, u_light_dir[l]), u_light_cone[l].x, u_light_cone[l].y);
         } else {
             travel = u_light_dir[l];
             E = u_light_color[l];
@@ -85,12 +90,11 @@ void main()
         uint h = hash32(uint(p.x) + hash32(uint(p.y) + hash32(u_seed)));
         float jitter = (float(h >> 8) + 1.0) * (1.0 / 16777216.0); // (0, 1]
         float t = span.x, seg = jitter * u_step;
-        vec3 inv_ext = 1.0 / (u_box_max - u_box_min);
         while (t < span.y) {
             float te = min(t + seg, span.y);
             float dt = te - t;
             vec3 x = u_cam_pos + dir * (0.5 * (t + te));
-            vec3 uvw = (x - u_box_min) * inv_ext;
+            vec3 uvw = (x - u_tex_min) * u_tex_inv_size;
             float rho = texture(u_ev, uvw).r;
             if (rho > 0.0) {
                 vec3 opt = u_sigma_t * (rho * dt);

@@ -1,0 +1,230 @@
+/* veil — the per-voxel updates of every optical-depth scheme, written once
+ * for C and GLSL (see core/shared.glsl.h for the portability macros). The
+ * shaders and the C reference implementations include this file, so each
+ * scheme does exactly the same float operations on the CPU and the GPU.
+ *
+ * Index space: voxel (i,j,k)'s centre is the point (i,j,k); the medium
+ * spans [0, n-1] per axis (volume/volume.h); h is the voxel edge (m). D is
+ * the density integral from a voxel centre to the light (density·m).
+ *
+ * The includer defines, before including:
+ *   VEIL_CTX_PARAM / VEIL_CTX_ARG  a leading parameter/argument carrying its
+ *                                  data (empty in GLSL)
+ *   VEIL_DIMS(a)        grid size along axis a (int)
+ *   VEIL_RHO(i,j,k)     density of voxel (i,j,k)
+ *   VEIL_DIN(i,j,k)     D of voxel (i,j,k) as far as computed (the previous
+ *                       Jacobi step, or the current texture in a sweep)
+ *
+ * Lights: `type` VEIL_LIGHT_DIRECTIONAL uses L = unit vector toward the
+ * light; otherwise L = the light's position in index space and c = its
+ * voxel, c_a = floor(L_a + 1/2) (passed in, computed in double by the caller).
+ */
+#ifndef VEIL_OPV_SCHEMES_GLSL_H
+#define VEIL_OPV_SCHEMES_GLSL_H
+
+/* Points this many samples along the segment to a light in the near field
+ * (the voxels within 2 of a point light, L-infinity): midpoint rule. */
+#define VEIL_NEAR_SAMPLES 16
+
+/* Trilinear density at index-space point p, clamped into the medium's box
+ * (for points that rounding put just outside). */
+VEIL_FN float veil_rho_clamped(VEIL_CTX_PARAM float p0, float p1, float p2)
+{
+    int lo[3], hi[3];
+    float f[3];
+    float p[3];
+    p[0] = p0;
+    p[1] = p1;
+    p[2] = p2;
+    for (int a = 0; a < 3; ++a) {
+        float q = VEIL_MINF(VEIL_MAXF(p[a], 0.0f), VEIL_FLOAT(VEIL_DIMS(a) - 1));
+        float fl = VEIL_FLOORF(q);
+        lo[a] = VEIL_INT(fl);
+        hi[a] = lo[a] + 1 < VEIL_DIMS(a) ? lo[a] + 1 : lo[a];
+        f[a] = q - fl;
+    }
+    VEIL_PRECISE float c00 = VEIL_RHO(lo[0], lo[1], lo[2]) * (1.0f - f[0]) + VEIL_RHO(hi[0], lo[1], lo[2]) * f[0];
+    VEIL_PRECISE float c10 = VEIL_RHO(lo[0], hi[1], lo[2]) * (1.0f - f[0]) + VEIL_RHO(hi[0], hi[1], lo[2]) * f[0];
+    VEIL_PRECISE float c01 = VEIL_RHO(lo[0], lo[1], hi[2]) * (1.0f - f[0]) + VEIL_RHO(hi[0], lo[1], hi[2]) * f[0];
+    VEIL_PRECISE float c11 = VEIL_RHO(lo[0], hi[1], hi[2]) * (1.0f - f[0]) + VEIL_RHO(hi[0], hi[1], hi[2]) * f[0];
+    VEIL_PRECISE float c0 = c00 * (1.0f - f[1]) + c10 * f[1];
+    VEIL_PRECISE float c1 = c01 * (1.0f - f[1]) + c11 * f[1];
+    VEIL_PRECISE float r = c0 * (1.0f - f[2]) + c1 * f[2];
+    return r;
+}
+
+/* As above, but 0 outside the box: the medium's density at p. */
+VEIL_FN float veil_rho_at(VEIL_CTX_PARAM float p0, float p1, float p2)
+{
+    if (p0 < 0.0f || p1 < 0.0f || p2 < 0.0f || p0 > VEIL_FLOAT(VEIL_DIMS(0) - 1) ||
+        p1 > VEIL_FLOAT(VEIL_DIMS(1) - 1) || p2 > VEIL_FLOAT(VEIL_DIMS(2) - 1))
+        return 0.0f;
+    return veil_rho_clamped(VEIL_CTX_ARG p0, p1, p2);
+}
+
+/* The axis-neighbour gather (the published scheme): the cosine-weighted
+ * mean over up-wind axis neighbours N of D(N) + step density. The step's
+ * density is the trapezoid (rho(X) + rho(N)) / 2 times a length: one voxel
+ * (published; Manhattan in effect), or, `corrected`, h |d|_2 / sum|d_a| over
+ * the up-wind axes, the expected Euclidean progress of a step (exact on the
+ * axes and on average). A voxel with an up-wind neighbour outside the grid
+ * lies on a face of the medium that the light enters by: D = 0. In the
+ * light's own voxel D = rho(X) h |d|. */
+VEIL_FN float veil_gather_cell(VEIL_CTX_PARAM int x0, int x1, int x2, int type, float l0, float l1, float l2,
+                               int c0, int c1, int c2, float h, int corrected)
+{
+    int x[3], c[3];
+    VEIL_PRECISE float d[3];
+    x[0] = x0; x[1] = x1; x[2] = x2;
+    c[0] = c0; c[1] = c1; c[2] = c2;
+    d[0] = type == VEIL_LIGHT_DIRECTIONAL ? l0 : l0 - VEIL_FLOAT(x0);
+    d[1] = type == VEIL_LIGHT_DIRECTIONAL ? l1 : l1 - VEIL_FLOAT(x1);
+    d[2] = type == VEIL_LIGHT_DIRECTIONAL ? l2 : l2 - VEIL_FLOAT(x2);
+    bool valid[3];
+    VEIL_PRECISE float wsum = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        valid[a] = type == VEIL_LIGHT_DIRECTIONAL ? d[a] != 0.0f : x[a] != c[a];
+        if (valid[a]) wsum += VEIL_ABSF(d[a]);
+    }
+    float r = VEIL_RHO(x0, x1, x2);
+    VEIL_PRECISE float len = VEIL_SQRTF(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (!valid[0] && !valid[1] && !valid[2]) {
+        VEIL_PRECISE float own = r * (h * len);
+        return own;
+    }
+    VEIL_PRECISE float step = corrected != 0 ? h * (len / wsum) : h;
+    VEIL_PRECISE float acc = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        if (!valid[a]) continue;
+        int n[3];
+        n[0] = x0; n[1] = x1; n[2] = x2;
+        n[a] += d[a] > 0.0f ? 1 : -1;
+        if (n[a] < 0 || n[a] >= VEIL_DIMS(a)) return 0.0f;
+        VEIL_PRECISE float term = VEIL_DIN(n[0], n[1], n[2]) + 0.5f * step * (r + VEIL_RHO(n[0], n[1], n[2]));
+        acc += (VEIL_ABSF(d[a]) / wsum) * term;
+    }
+    return acc;
+}
+
+/* Near field of a point light: D by the midpoint rule along the straight
+ * segment (VEIL_NEAR_SAMPLES samples), density 0 outside the box. */
+VEIL_FN float veil_near_cell(VEIL_CTX_PARAM int x0, int x1, int x2, float l0, float l1, float l2, float h)
+{
+    VEIL_PRECISE float e0 = l0 - VEIL_FLOAT(x0), e1 = l1 - VEIL_FLOAT(x1), e2 = l2 - VEIL_FLOAT(x2);
+    VEIL_PRECISE float sum = 0.0f;
+    for (int k = 0; k < VEIL_NEAR_SAMPLES; ++k) {
+        VEIL_PRECISE float t = (VEIL_FLOAT(k) + 0.5f) / VEIL_FLOAT(VEIL_NEAR_SAMPLES);
+        sum += veil_rho_at(VEIL_CTX_ARG VEIL_FLOAT(x0) + e0 * t, VEIL_FLOAT(x1) + e1 * t, VEIL_FLOAT(x2) + e2 * t);
+    }
+    VEIL_PRECISE float len = VEIL_SQRTF(e0 * e0 + e1 * e1 + e2 * e2);
+    VEIL_PRECISE float D = h * len * (sum / VEIL_FLOAT(VEIL_NEAR_SAMPLES));
+    return D;
+}
+
+/* The axis a semi-Lagrangian step takes: a sun's dominant axis (the first
+ * largest |l_a|); for a point light, among the axes with the largest
+ * |x_a - c_a|, the one with the largest real offset |l_a - x_a| (then the
+ * first). See propagate/opv_plan.h for why this order is safe. */
+VEIL_FN int veil_sl_axis(int x0, int x1, int x2, int type, float l0, float l1, float l2, int c0, int c1, int c2)
+{
+    float e[3];
+    int dist[3];
+    e[0] = type == VEIL_LIGHT_DIRECTIONAL ? l0 : l0 - VEIL_FLOAT(x0);
+    e[1] = type == VEIL_LIGHT_DIRECTIONAL ? l1 : l1 - VEIL_FLOAT(x1);
+    e[2] = type == VEIL_LIGHT_DIRECTIONAL ? l2 : l2 - VEIL_FLOAT(x2);
+    dist[0] = type == VEIL_LIGHT_DIRECTIONAL ? 0 : (x0 > c0 ? x0 - c0 : c0 - x0);
+    dist[1] = type == VEIL_LIGHT_DIRECTIONAL ? 0 : (x1 > c1 ? x1 - c1 : c1 - x1);
+    dist[2] = type == VEIL_LIGHT_DIRECTIONAL ? 0 : (x2 > c2 ? x2 - c2 : c2 - x2);
+    int a = 0;
+    for (int b = 1; b < 3; ++b)
+        if (dist[b] > dist[a] || (dist[b] == dist[a] && VEIL_ABSF(e[b]) > VEIL_ABSF(e[a]))) a = b;
+    return a;
+}
+
+/* Semi-Lagrangian up-wind step: follow the true direction e toward the light
+ * from X to the next voxel plane along axis a (one voxel along a), read D
+ * there bilinearly from the four voxels around the crossing point, and add
+ * the trapezoid of the density along that segment. If the ray leaves the
+ * medium's box within `exit_steps` steps (at least 1), D is integrated
+ * directly to the exit point, one trapezoid per step: bilinear reads near
+ * the light-facing faces would mix voxels whose rays leave through
+ * different faces (a kink in D) and err most where D is smallest. Needs |e_a| >= 1 and
+ * |e_b| <= |e_a| (what veil_sl_axis guarantees outside the near field; the
+ * crossing point is also clamped to within one voxel of X). */
+VEIL_FN float veil_sl_cell(VEIL_CTX_PARAM int x0, int x1, int x2, int a, int type, float l0, float l1, float l2,
+                           float h, float exit_steps)
+{
+    int x[3];
+    VEIL_PRECISE float e[3];
+    x[0] = x0; x[1] = x1; x[2] = x2;
+    e[0] = type == VEIL_LIGHT_DIRECTIONAL ? l0 : l0 - VEIL_FLOAT(x0);
+    e[1] = type == VEIL_LIGHT_DIRECTIONAL ? l1 : l1 - VEIL_FLOAT(x1);
+    e[2] = type == VEIL_LIGHT_DIRECTIONAL ? l2 : l2 - VEIL_FLOAT(x2);
+    VEIL_PRECISE float t_plane = 1.0f / VEIL_ABSF(e[a]);
+    VEIL_PRECISE float t_exit = 3.0e38f;
+    for (int b = 0; b < 3; ++b) {
+        if (e[b] == 0.0f) continue;
+        VEIL_PRECISE float face = e[b] > 0.0f ? VEIL_FLOAT(VEIL_DIMS(b) - 1) : 0.0f;
+        VEIL_PRECISE float tb = (face - VEIL_FLOAT(x[b])) / e[b];
+        t_exit = VEIL_MINF(t_exit, tb);
+    }
+    VEIL_PRECISE float len = VEIL_SQRTF(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    float r = VEIL_RHO(x0, x1, x2);
+    if (t_exit <= exit_steps * t_plane) {
+        /* the ray leaves the medium within exit_steps steps:
+         * integrate to the exit directly, trapezoids of at most one step,
+         * rather than interpolate across the kink where neighbouring rays
+         * leave through another face */
+        VEIL_PRECISE float t = VEIL_MAXF(t_exit, 0.0f);
+        VEIL_PRECISE float D = 0.0f, t0 = 0.0f, r0 = r;
+        int n = VEIL_INT(VEIL_FLOORF(t / t_plane)) + 1;
+        for (int k = 1; k <= n; ++k) {
+            VEIL_PRECISE float t1 = VEIL_MINF(t, VEIL_FLOAT(k) * t_plane);
+            VEIL_PRECISE float r1 = veil_rho_clamped(VEIL_CTX_ARG VEIL_FLOAT(x0) + e[0] * t1,
+                                                     VEIL_FLOAT(x1) + e[1] * t1, VEIL_FLOAT(x2) + e[2] * t1);
+            D += h * (len * (t1 - t0)) * (0.5f * (r0 + r1));
+            t0 = t1;
+            r0 = r1;
+        }
+        return D;
+    }
+    /* the crossing point q on plane x_a + sign(e_a); its other coordinates
+     * are kept within one voxel of X (rounding could step past it) */
+    VEIL_PRECISE float q[3];
+    int lo[3], hi[3];
+    float f[3];
+    for (int b = 0; b < 3; ++b) {
+        if (b == a) {
+            q[b] = VEIL_FLOAT(x[b] + (e[b] > 0.0f ? 1 : -1));
+            lo[b] = VEIL_INT(q[b]);
+            hi[b] = lo[b];
+            f[b] = 0.0f;
+            continue;
+        }
+        q[b] = VEIL_FLOAT(x[b]) + e[b] * t_plane;
+        float qc = VEIL_MINF(VEIL_MAXF(q[b], VEIL_FLOAT(x[b] - 1)), VEIL_FLOAT(x[b] + 1));
+        qc = VEIL_MINF(VEIL_MAXF(qc, 0.0f), VEIL_FLOAT(VEIL_DIMS(b) - 1));
+        float fl = VEIL_FLOORF(qc);
+        lo[b] = VEIL_INT(fl);
+        f[b] = qc - fl;
+        hi[b] = f[b] > 0.0f ? lo[b] + 1 : lo[b];
+    }
+    /* bilinear over the two axes other than a (f[a] = 0, lo[a] = hi[a]) */
+    VEIL_PRECISE float d00 = VEIL_DIN(lo[0], lo[1], lo[2]);
+    int b1 = a == 0 ? 1 : 0, b2 = a == 2 ? 1 : 2;
+    int i1[3], i2[3], i3[3];
+    for (int k = 0; k < 3; ++k) {
+        i1[k] = k == b1 ? hi[k] : lo[k];
+        i2[k] = k == b2 ? hi[k] : lo[k];
+        i3[k] = k == b1 || k == b2 ? hi[k] : lo[k];
+    }
+    VEIL_PRECISE float d10 = VEIL_DIN(i1[0], i1[1], i1[2]);
+    VEIL_PRECISE float d01 = VEIL_DIN(i2[0], i2[1], i2[2]);
+    VEIL_PRECISE float d11 = VEIL_DIN(i3[0], i3[1], i3[2]);
+    VEIL_PRECISE float dq = (d00 * (1.0f - f[b1]) + d10 * f[b1]) * (1.0f - f[b2]) + (d01 * (1.0f - f[b1]) + d11 * f[b1]) * f[b2];
+    VEIL_PRECISE float rq = veil_rho_clamped(VEIL_CTX_ARG q[0], q[1], q[2]);
+    VEIL_PRECISE float D = dq + h * (len * t_plane) * (0.5f * (r + rq));
+    return D;
+}
+
+#endif

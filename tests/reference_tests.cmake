@@ -1,0 +1,3 @@
+# CPU ground truth for optical depth (reference/): exactness, closed forms,
+# and convergence of the midpoint rule and of the voxelisation.
+veil_test(test_reference SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_reference.c LABELS "unit;accuracy")
