@@ -1,7 +1,7 @@
 /* veil — the command-line tool.
  *
  *   veil render SCENE.json -o OUT.exr [--png OUT.png] [--width W] [--height H]
- *               [--step S] [--seed N] [--stats]
+ *               [--step S] [--seed N] [--method M] [--turntable N] [--stats]
  *   veil gpuinfo
  *   veil --help | --version
  *
@@ -11,6 +11,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,7 +28,7 @@ enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2, EXIT_GPU = 3 };
 
 static const char* usage_text =
     "usage: veil render SCENE.json -o OUT.exr [--png OUT.png] [--width W] [--height H]\n"
-    "                   [--step S] [--seed N] [--stats]\n"
+    "                   [--step S] [--seed N] [--method M] [--turntable N] [--stats]\n"
     "       veil gpuinfo\n"
     "       veil --help | --version\n"
     "\n"
@@ -38,6 +39,11 @@ static const char* usage_text =
     "  --width W, --height H  override the scene camera's image size (1..16384)\n"
     "  --step S       ray-march step in voxels (default 0.5)\n"
     "  --seed N       jitter seed (default 0)\n"
+    "  --method M     optical-depth propagation: semi-lagrangian (default), sweep,\n"
+    "                 jacobi-corrected, jacobi (the published scheme)\n"
+    "  --turntable N  N frames with the camera orbiting the look-at point about the\n"
+    "                 up axis, written as OUT_0000.exr ... (volume and optical depth\n"
+    "                 are computed once and reused: see --stats)\n"
     "  --stats        print the wall time of each stage in milliseconds\n"
     "gpuinfo  prints the EGL platform and device, GL vendor, renderer, version and\n"
     "         the largest 3D texture. VEIL_DEVICE=software forces llvmpipe.\n"
@@ -115,8 +121,9 @@ static int cmd_gpuinfo(void)
 
 typedef struct render_args {
     const char *scene, *exr, *png;
-    long width, height, seed;
+    long width, height, seed, frames;
     float step;
+    veil_opv_method method;
     int stats;
 } render_args;
 
@@ -128,7 +135,8 @@ static int parse_render_args(int argc, char** argv, render_args* a)
         const char* v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(s, "--stats")) { a->stats = 1; continue; }
         int takes = !strcmp(s, "-o") || !strcmp(s, "--png") || !strcmp(s, "--width") || !strcmp(s, "--height") ||
-                    !strcmp(s, "--step") || !strcmp(s, "--seed");
+                    !strcmp(s, "--step") || !strcmp(s, "--seed") || !strcmp(s, "--method") ||
+                    !strcmp(s, "--turntable");
         if (takes && !v) return usage_error("%s needs a value", s);
         if (!strcmp(s, "-o")) a->exr = v;
         else if (!strcmp(s, "--png")) a->png = v;
@@ -139,7 +147,12 @@ static int parse_render_args(int argc, char** argv, render_args* a)
         } else if (!strcmp(s, "--step")) {
             if (!parse_float(v, 0.01f, 16.0f, &a->step)) return usage_error("--step: expected a number of voxels in 0.01..16, got '%s'", v);
         } else if (!strcmp(s, "--seed")) {
-            if (!parse_int(v, 0, UINT32_MAX > LONG_MAX ? LONG_MAX : (long)UINT32_MAX, &a->seed)) return usage_error("--seed: expected an integer in 0..4294967295, got '%s'", v);
+            if (!parse_int(v, 0, 4294967295L, &a->seed)) return usage_error("--seed: expected an integer in 0..4294967295, got '%s'", v);
+        } else if (!strcmp(s, "--turntable")) {
+            if (!parse_int(v, 1, 100000, &a->frames)) return usage_error("--turntable: expected a number of frames in 1..100000, got '%s'", v);
+        } else if (!strcmp(s, "--method")) {
+            if (!veil_opv_method_parse(v, &a->method))
+                return usage_error("--method: expected default, jacobi, jacobi-corrected, sweep or semi-lagrangian, got '%s'", v);
         } else if (s[0] == '-' && s[1]) return usage_error("unknown option '%s'", s);
         else if (!a->scene) { a->scene = s; continue; }
         else return usage_error("unexpected argument '%s'", s);
@@ -167,6 +180,60 @@ static veil_result check_output_folder(const char* path, veil_error* err)
     return VEIL_OK;
 }
 
+/* "out/t.exr", frame 7 -> "out/t_0007.exr" (a turntable's frame files). */
+static void frame_path(const char* path, long frame, int numbered, char* out, size_t n)
+{
+    if (!numbered) {
+        snprintf(out, n, "%s", path);
+        return;
+    }
+    const char* slash = strrchr(path, '/');
+    const char* dot = strrchr(path, '.');
+    if (!dot || (slash && dot < slash)) dot = path + strlen(path);
+    snprintf(out, n, "%.*s_%04ld%s", (int)(dot - path), path, frame, dot);
+}
+
+/* The scene camera turned by `angle` radians about the up axis through look_at. */
+static veil_camera orbit(const veil_camera* c, double angle)
+{
+    veil_camera o = *c;
+    double u[3], v[3], len = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        u[a] = c->up[a];
+        len += u[a] * u[a];
+        v[a] = (double)c->position[a] - c->look_at[a];
+    }
+    len = sqrt(len);
+    for (int a = 0; a < 3; ++a) u[a] /= len;
+    double cs = cos(angle), sn = sin(angle), uv = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    double x[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    for (int a = 0; a < 3; ++a)
+        o.position[a] = (float)(c->look_at[a] + v[a] * cs + x[a] * sn + u[a] * uv * (1.0 - cs));
+    return o;
+}
+
+static void print_stats(const veil_render_stats* st, size_t lights, int w, int h, double write_ms)
+{
+    printf("inject     %9.2f ms", st->inject_ms);
+    if (st->inject_cached)
+        printf("  (cached)\n");
+    else if (st->has_volume)
+        printf("  (%zu particles, grid %dx%dx%d, voxel %.4g m)\n", st->particles, st->grid.dims[0], st->grid.dims[1],
+               st->grid.dims[2], st->grid.voxel);
+    else
+        printf("  (empty medium: no volume)\n");
+    printf("propagate  %9.2f ms", st->propagate_ms);
+    if (st->lights_used == 0)
+        printf("  (no light reaches the medium: skipped)\n");
+    else if (st->opv_computed == 0)
+        printf("  (cached: %d lights, %s)\n", st->lights_used, veil_opv_method_name(st->method));
+    else
+        printf("  (%d of %zu lights, %s, %d passes; %d textures computed, %d cached)\n", st->lights_used, lights,
+               veil_opv_method_name(st->method), st->propagate_iterations, st->opv_computed, st->opv_cached);
+    printf("render     %9.2f ms  (%dx%d)\n", st->render_ms, w, h);
+    printf("write      %9.2f ms\n", write_ms);
+}
+
 static int cmd_render(int argc, char** argv)
 {
     render_args a;
@@ -183,41 +250,37 @@ static int cmd_render(int argc, char** argv)
 
     veil_gl* gl = NULL;
     veil_renderer* ren = NULL;
-    float* rgba = NULL;
-    veil_render_stats st = {0};
-    veil_render_opts opts = {.width = (int)a.width, .height = (int)a.height, .step_voxels = a.step,
-                             .seed = (uint32_t)a.seed};
     r = veil_gl_create(NULL, &gl, &err);
     if (r == VEIL_OK) r = veil_renderer_create(gl, &ren, &err);
-    if (r == VEIL_OK) {
+    int w = a.width ? (int)a.width : scene.camera.width, h = a.height ? (int)a.height : scene.camera.height;
+    long frames = a.frames > 0 ? a.frames : 1;
+    for (long f = 0; f < frames && r == VEIL_OK; ++f) {
+        veil_camera cam = orbit(&scene.camera, 2.0 * VEIL_PI * (double)f / (double)frames);
+        veil_render_opts opts = {.width = (int)a.width, .height = (int)a.height, .step_voxels = a.step,
+                                 .seed = (uint32_t)a.seed, .method = a.method, .camera = &cam};
+        veil_render_stats st = {0};
+        float* rgba = NULL;
         r = veil_render_scene(ren, &scene, &opts, &rgba, &st, &err);
         if (r != VEIL_OK && exit_code(r) == EXIT_INPUT) prefix_error(&err, a.scene);
+        char exr[4096], png[4096];
+        frame_path(a.exr, f, a.frames > 0, exr, sizeof exr);
+        if (a.png) frame_path(a.png, f, a.frames > 0, png, sizeof png);
+        double t_write = veil_now_ms();
+        if (r == VEIL_OK) r = veil_write_exr(exr, w, h, rgba, &err);
+        if (r == VEIL_OK && a.png) {
+            r = veil_write_png(png, w, h, rgba, 0.0f, &err);
+            if (r != VEIL_OK) unlink(exr); /* all or nothing, per frame */
+        }
+        free(rgba);
+        if (r != VEIL_OK) break;
+        if (a.stats) {
+            if (frames > 1) printf("frame %ld\n", f);
+            print_stats(&st, scene.light_count, w, h, veil_now_ms() - t_write);
+        }
+        if (frames == 1 || f == frames - 1)
+            printf("wrote %s%s%s%s in %.2f s\n", frames > 1 ? "frames up to " : "", exr, a.png ? " and " : "",
+                   a.png ? png : "", (veil_now_ms() - t_start) * 1e-3);
     }
-    int w = a.width ? (int)a.width : scene.camera.width, h = a.height ? (int)a.height : scene.camera.height;
-    double t_write = veil_now_ms();
-    if (r == VEIL_OK) r = veil_write_exr(a.exr, w, h, rgba, &err);
-    if (r == VEIL_OK && a.png) {
-        r = veil_write_png(a.png, w, h, rgba, 0.0f, &err);
-        if (r != VEIL_OK) unlink(a.exr); /* all or nothing */
-    }
-    double t_end = veil_now_ms();
-    if (r == VEIL_OK && a.stats) {
-        fprintf(stdout, "inject     %9.2f ms", st.inject_ms);
-        if (st.has_volume)
-            fprintf(stdout, "  (%zu particles, grid %dx%dx%d, voxel %.4g m)\n", st.particles, st.grid.dims[0],
-                    st.grid.dims[1], st.grid.dims[2], st.grid.voxel);
-        else
-            fprintf(stdout, "  (empty medium: skipped)\n");
-        fprintf(stdout, "propagate  %9.2f ms  (%zu lights, %d Jacobi iterations)\n", st.propagate_ms,
-                scene.light_count, st.propagate_iterations);
-        fprintf(stdout, "render     %9.2f ms  (%dx%d)\n", st.render_ms, w, h);
-        fprintf(stdout, "write      %9.2f ms\n", t_end - t_write);
-    }
-    if (r == VEIL_OK) {
-        printf("wrote %s%s%s in %.2f s\n", a.exr, a.png ? " and " : "", a.png ? a.png : "",
-               (t_end - t_start) * 1e-3);
-    }
-    free(rgba);
     veil_renderer_destroy(ren);
     veil_gl_destroy(gl);
     veil_scene_free(&scene);

@@ -144,9 +144,9 @@ VEIL_FN int veil_sl_axis(int x0, int x1, int x2, int type, float l0, float l1, f
 /* Semi-Lagrangian up-wind step: follow the true direction e toward the light
  * from X to the next voxel plane along axis a (one voxel along a), read D
  * there bilinearly from the four voxels around the crossing point, and add
- * the trapezoid of the density along that segment. If the ray leaves the
- * medium's box within `exit_steps` steps (at least 1), D is integrated
- * directly to the exit point, one trapezoid per step: bilinear reads near
+ * the trapezoid of the density along that segment. If the path ends (at
+ * the medium's face, or at a point light) within `exit_steps` steps (at
+ * least 1), D is integrated directly to the end, one trapezoid per step: bilinear reads near
  * the light-facing faces would mix voxels whose rays leave through
  * different faces (a kink in D) and err most where D is smallest. Needs |e_a| >= 1 and
  * |e_b| <= |e_a| (what veil_sl_axis guarantees outside the near field; the
@@ -161,7 +161,8 @@ VEIL_FN float veil_sl_cell(VEIL_CTX_PARAM int x0, int x1, int x2, int a, int typ
     e[1] = type == VEIL_LIGHT_DIRECTIONAL ? l1 : l1 - VEIL_FLOAT(x1);
     e[2] = type == VEIL_LIGHT_DIRECTIONAL ? l2 : l2 - VEIL_FLOAT(x2);
     VEIL_PRECISE float t_plane = 1.0f / VEIL_ABSF(e[a]);
-    VEIL_PRECISE float t_exit = 3.0e38f;
+    /* where the path ends: a point light at t = 1, or the medium's face */
+    VEIL_PRECISE float t_exit = type == VEIL_LIGHT_DIRECTIONAL ? 3.0e38f : 1.0f;
     for (int b = 0; b < 3; ++b) {
         if (e[b] == 0.0f) continue;
         VEIL_PRECISE float face = e[b] > 0.0f ? VEIL_FLOAT(VEIL_DIMS(b) - 1) : 0.0f;

@@ -8,3 +8,4 @@ add_test(NAME cli_end_to_end
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli_end_to_end.sh $<TARGET_FILE:veil_cli>
           ${PROJECT_SOURCE_DIR}/data/scenes/demo.json)
 set_tests_properties(cli_end_to_end PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)
+veil_test(test_render_cache SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_render_cache.c LABELS gpu)
