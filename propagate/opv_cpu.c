@@ -123,14 +123,15 @@ static void gather_sweep(const veil_grid* g, const float* rho, const veil_opv_li
         for (x[1] = (b).lo[1]; x[1] < (b).lo[1] + (b).n[1]; ++x[1])                  \
             for (x[0] = (b).lo[0]; x[0] < (b).lo[0] + (b).n[0]; ++x[0])
 
-static float sl_voxel(const veil__opv_ctx* ctx, const veil_opv_light* L, const int x[3], float h, float exit_steps)
+static float sl_voxel(const veil__opv_ctx* ctx, const veil_opv_light* L, const int x[3], float h, int k,
+                      float exit_steps)
 {
     int a = veil_sl_axis(x[0], x[1], x[2], L->type, L->v[0], L->v[1], L->v[2], L->c[0], L->c[1], L->c[2]);
-    return veil_sl_cell(ctx, x[0], x[1], x[2], a, L->type, L->v[0], L->v[1], L->v[2], h, exit_steps);
+    return veil_sl_cell(ctx, x[0], x[1], x[2], a, L->type, L->v[0], L->v[1], L->v[2], h, k, exit_steps);
 }
 
-static void semi_lagrangian(const veil_grid* g, const float* rho, const veil_opv_light* L, float exit_steps, float* out,
-                            int* passes)
+static void semi_lagrangian(const veil_grid* g, const float* rho, const veil_opv_light* L, int chars, float exit_steps,
+                            float* out, int* passes)
 {
     veil__opv_ctx ctx = {.rho = rho, .din = out, .dims = {g->dims[0], g->dims[1], g->dims[2]}};
     int x[3], n = 0;
@@ -139,7 +140,7 @@ static void semi_lagrangian(const veil_grid* g, const float* rho, const veil_opv
         int a = veil__sl_sun_axis(L);
         for (int k = 0; k < g->dims[a]; ++k, ++n) {
             veil__sl_sun_slice(g, L, k, &box);
-            FOR_BOX(box, x) out[vox(g, x)] = sl_voxel(&ctx, L, x, g->voxel, exit_steps);
+            FOR_BOX(box, x) out[vox(g, x)] = sl_voxel(&ctx, L, x, g->voxel, chars, exit_steps);
         }
         *passes = n;
         return;
@@ -154,7 +155,7 @@ static void semi_lagrangian(const veil_grid* g, const float* rho, const veil_opv
         for (int k = 1; k <= 3; ++k) {
             veil__box boxes[VEIL_SL_MAX_BOXES];
             int nb = veil__sl_boxes(g, L, s, k, boxes);
-            for (int b = 0; b < nb; ++b) FOR_BOX(boxes[b], x) out[vox(g, x)] = sl_voxel(&ctx, L, x, g->voxel, exit_steps);
+            for (int b = 0; b < nb; ++b) FOR_BOX(boxes[b], x) out[vox(g, x)] = sl_voxel(&ctx, L, x, g->voxel, chars, exit_steps);
             n += nb > 0;
         }
     *passes = n;
@@ -187,7 +188,8 @@ veil_result veil_opv_cpu(const veil_grid* g, const float* rho, const veil_opv_li
             break;
         default:
             memset(cur, 0, nv * sizeof(float));
-            semi_lagrangian(g, rho, &lights[l], veil_opv_exit_steps(params), cur, &it);
+            semi_lagrangian(g, rho, &lights[l], veil_opv_characteristic(params), veil_opv_exit_steps(params), cur,
+                            &it);
             break;
         }
         if (it > most) most = it;

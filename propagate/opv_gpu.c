@@ -196,6 +196,7 @@ veil_result veil_opv_gpu(const veil_opv_programs* p, const veil_grid* g, GLuint 
         glProgramUniform3i(prog, loc(prog, "u_dims"), g->dims[0], g->dims[1], g->dims[2]);
         glProgramUniform1f(prog, loc(prog, "u_voxel"), g->voxel);
         glProgramUniform1f(prog, loc(prog, "u_exit_steps"), veil_opv_exit_steps(params));
+        glProgramUniform1i(prog, loc(prog, "u_characteristic"), veil_opv_characteristic(params));
         for (int t = 0; 4 * t < n_lights; ++t) {
             glClearTexImage(opv[t], 0, GL_RGBA, GL_FLOAT, zero);
             glBindImageTexture(VEIL_IMAGE_OPV_DST, opv[t], 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);

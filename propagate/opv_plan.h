@@ -33,7 +33,12 @@ int veil__gather_solve(const veil_grid* g, const veil_opv_light* l, const veil__
  * three sub-passes, k = 1 (faces), 2 (edges), 3 (corners), each a list of
  * boxes. Shells 0 and 1 (the 27 voxels around the light, where stepping
  * toward the light can move away from c) are the near field, integrated
- * directly. */
+ * directly.
+ * With characteristics k >= 2 voxels long the reads are simpler still: the
+ * crossing point Q lies k voxels nearer on axis a, and on another axis b
+ * |Q_b - S_b| = |e_b| (1 - k/|e_a|) <= |e_a| - k, so the voxels read have
+ * distance at most s - k + 1 < s on every axis: all in earlier shells (a
+ * path that ends within k voxels is integrated without reading any). */
 #define VEIL_SL_MAX_BOXES 12 /* edges of a cube: the most boxes of a sub-pass */
 
 typedef struct veil__box {

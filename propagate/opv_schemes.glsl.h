@@ -141,18 +141,47 @@ VEIL_FN int veil_sl_axis(int x0, int x1, int x2, int type, float l0, float l1, f
     return a;
 }
 
-/* Semi-Lagrangian up-wind step: follow the true direction e toward the light
- * from X to the next voxel plane along axis a (one voxel along a), read D
- * there bilinearly from the four voxels around the crossing point, and add
- * the trapezoid of the density along that segment. If the path ends (at
- * the medium's face, or at a point light) within `exit_steps` steps (at
- * least 1), D is integrated directly to the end, one trapezoid per step: bilinear reads near
- * the light-facing faces would mix voxels whose rays leave through
- * different faces (a kink in D) and err most where D is smallest. Needs |e_a| >= 1 and
- * |e_b| <= |e_a| (what veil_sl_axis guarantees outside the near field; the
- * crossing point is also clamped to within one voxel of X). */
+/* Where the path from voxel y to the light ends: 6 + 0 at a point light,
+ * else 2 b + (e_b > 0) for the face of the medium it leaves by (first
+ * axis on ties). D is smooth where this is constant and has a kink where
+ * it changes. */
+VEIL_FN int veil_path_end(VEIL_CTX_PARAM int y0, int y1, int y2, int type, float l0, float l1, float l2)
+{
+    float e[3];
+    int y[3];
+    y[0] = y0; y[1] = y1; y[2] = y2;
+    e[0] = type == VEIL_LIGHT_DIRECTIONAL ? l0 : l0 - VEIL_FLOAT(y0);
+    e[1] = type == VEIL_LIGHT_DIRECTIONAL ? l1 : l1 - VEIL_FLOAT(y1);
+    e[2] = type == VEIL_LIGHT_DIRECTIONAL ? l2 : l2 - VEIL_FLOAT(y2);
+    float best = type == VEIL_LIGHT_DIRECTIONAL ? 3.0e38f : 1.0f;
+    int end = 6;
+    for (int b = 0; b < 3; ++b) {
+        if (e[b] == 0.0f) continue;
+        float face = e[b] > 0.0f ? VEIL_FLOAT(VEIL_DIMS(b) - 1) : 0.0f;
+        float tb = (face - VEIL_FLOAT(y[b])) / e[b];
+        if (tb < best) {
+            best = tb;
+            end = 2 * b + (e[b] > 0.0f ? 1 : 0);
+        }
+    }
+    return end;
+}
+
+/* Semi-Lagrangian up-wind step with characteristics `k` voxels long: follow
+ * the true direction e toward the light from X to the voxel plane k voxels
+ * away along axis a, integrating the density on the way (one trapezoid per
+ * voxel along a), and add D there, read bilinearly from the four voxels
+ * around the crossing point. k = 1 is the classic short characteristic;
+ * a longer one interpolates k times less often, so it diffuses sharp
+ * shadows and the kinks of D (where neighbouring rays enter the medium
+ * through different faces) k times less, at k density samples a voxel.
+ * If the path ends (at the medium's face, or at a point light) within
+ * max(k, exit_steps) voxels along a, D is integrated to the end instead.
+ * Needs |e_b| <= |e_a| and |e_a| >= 1 (what veil_sl_axis guarantees outside
+ * the near field); the crossing point is also clamped to within k voxels
+ * of X. See propagate/opv_plan.h for why the order is safe. */
 VEIL_FN float veil_sl_cell(VEIL_CTX_PARAM int x0, int x1, int x2, int a, int type, float l0, float l1, float l2,
-                           float h, float exit_steps)
+                           float h, int k, float exit_steps)
 {
     int x[3];
     VEIL_PRECISE float e[3];
@@ -160,27 +189,69 @@ VEIL_FN float veil_sl_cell(VEIL_CTX_PARAM int x0, int x1, int x2, int a, int typ
     e[0] = type == VEIL_LIGHT_DIRECTIONAL ? l0 : l0 - VEIL_FLOAT(x0);
     e[1] = type == VEIL_LIGHT_DIRECTIONAL ? l1 : l1 - VEIL_FLOAT(x1);
     e[2] = type == VEIL_LIGHT_DIRECTIONAL ? l2 : l2 - VEIL_FLOAT(x2);
-    VEIL_PRECISE float t_plane = 1.0f / VEIL_ABSF(e[a]);
+    VEIL_PRECISE float t_voxel = 1.0f / VEIL_ABSF(e[a]); /* one voxel along a */
     /* where the path ends: a point light at t = 1, or the medium's face */
-    VEIL_PRECISE float t_exit = type == VEIL_LIGHT_DIRECTIONAL ? 3.0e38f : 1.0f;
+    VEIL_PRECISE float t_end = type == VEIL_LIGHT_DIRECTIONAL ? 3.0e38f : 1.0f;
     for (int b = 0; b < 3; ++b) {
         if (e[b] == 0.0f) continue;
         VEIL_PRECISE float face = e[b] > 0.0f ? VEIL_FLOAT(VEIL_DIMS(b) - 1) : 0.0f;
         VEIL_PRECISE float tb = (face - VEIL_FLOAT(x[b])) / e[b];
-        t_exit = VEIL_MINF(t_exit, tb);
+        t_end = VEIL_MINF(t_end, tb);
     }
+    t_end = VEIL_MAXF(t_end, 0.0f);
     VEIL_PRECISE float len = VEIL_SQRTF(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-    float r = VEIL_RHO(x0, x1, x2);
-    if (t_exit <= exit_steps * t_plane) {
-        /* the ray leaves the medium within exit_steps steps:
-         * integrate to the exit directly, trapezoids of at most one step,
-         * rather than interpolate across the kink where neighbouring rays
-         * leave through another face */
-        VEIL_PRECISE float t = VEIL_MAXF(t_exit, 0.0f);
-        VEIL_PRECISE float D = 0.0f, t0 = 0.0f, r0 = r;
-        int n = VEIL_INT(VEIL_FLOORF(t / t_plane)) + 1;
-        for (int k = 1; k <= n; ++k) {
-            VEIL_PRECISE float t1 = VEIL_MINF(t, VEIL_FLOAT(k) * t_plane);
+    bool direct = t_end <= VEIL_MAXF(VEIL_FLOAT(k), exit_steps) * t_voxel;
+    VEIL_PRECISE float t_stop = direct ? t_end : VEIL_FLOAT(k) * t_voxel;
+    int n = direct ? VEIL_INT(VEIL_FLOORF(t_end / t_voxel)) + 1 : k;
+    VEIL_PRECISE float D = 0.0f, t0 = 0.0f;
+    float r0 = VEIL_RHO(x0, x1, x2);
+    for (int s = 1; s <= n; ++s) {
+        VEIL_PRECISE float t1 = VEIL_MINF(t_stop, VEIL_FLOAT(s) * t_voxel);
+        VEIL_PRECISE float r1 = veil_rho_clamped(VEIL_CTX_ARG VEIL_FLOAT(x0) + e[0] * t1, VEIL_FLOAT(x1) + e[1] * t1,
+                                                 VEIL_FLOAT(x2) + e[2] * t1);
+        D += h * (len * (t1 - t0)) * (0.5f * (r0 + r1));
+        t0 = t1;
+        r0 = r1;
+    }
+    if (direct) return D;
+    /* the crossing point on plane x_a + k sign(e_a), kept within k voxels of
+     * X on the other axes (rounding could step past) and inside the grid */
+    int lo[3], hi[3];
+    float f[3];
+    for (int b = 0; b < 3; ++b) {
+        if (b == a) {
+            lo[b] = x[b] + (e[b] > 0.0f ? k : -k);
+            hi[b] = lo[b];
+            f[b] = 0.0f;
+            continue;
+        }
+        VEIL_PRECISE float q = VEIL_FLOAT(x[b]) + e[b] * t_stop;
+        float qc = VEIL_MINF(VEIL_MAXF(q, VEIL_FLOAT(x[b] - k)), VEIL_FLOAT(x[b] + k));
+        qc = VEIL_MINF(VEIL_MAXF(qc, 0.0f), VEIL_FLOAT(VEIL_DIMS(b) - 1));
+        float fl = VEIL_FLOORF(qc);
+        lo[b] = VEIL_INT(fl);
+        f[b] = qc - fl;
+        hi[b] = f[b] > 0.0f ? lo[b] + 1 : lo[b];
+    }
+    /* bilinear over the two axes other than a */
+    int b1 = a == 0 ? 1 : 0, b2 = a == 2 ? 1 : 2;
+    int i1[3], i2[3], i3[3];
+    for (int c = 0; c < 3; ++c) {
+        i1[c] = c == b1 ? hi[c] : lo[c];
+        i2[c] = c == b2 ? hi[c] : lo[c];
+        i3[c] = c == b1 || c == b2 ? hi[c] : lo[c];
+    }
+    /* A stencil whose voxels' paths end differently straddles a kink of D:
+     * interpolating there errs by O(h) at every step along the kink and the
+     * errors add up. Such voxels (O(n^2) of them) integrate to the end. */
+    int end = veil_path_end(VEIL_CTX_ARG x0, x1, x2, type, l0, l1, l2);
+    if (veil_path_end(VEIL_CTX_ARG lo[0], lo[1], lo[2], type, l0, l1, l2) != end ||
+        veil_path_end(VEIL_CTX_ARG i1[0], i1[1], i1[2], type, l0, l1, l2) != end ||
+        veil_path_end(VEIL_CTX_ARG i2[0], i2[1], i2[2], type, l0, l1, l2) != end ||
+        veil_path_end(VEIL_CTX_ARG i3[0], i3[1], i3[2], type, l0, l1, l2) != end) {
+        int total_steps = VEIL_INT(VEIL_FLOORF(t_end / t_voxel)) + 1;
+        for (int s = n + 1; s <= total_steps; ++s) {
+            VEIL_PRECISE float t1 = VEIL_MINF(t_end, VEIL_FLOAT(s) * t_voxel);
             VEIL_PRECISE float r1 = veil_rho_clamped(VEIL_CTX_ARG VEIL_FLOAT(x0) + e[0] * t1,
                                                      VEIL_FLOAT(x1) + e[1] * t1, VEIL_FLOAT(x2) + e[2] * t1);
             D += h * (len * (t1 - t0)) * (0.5f * (r0 + r1));
@@ -189,43 +260,13 @@ VEIL_FN float veil_sl_cell(VEIL_CTX_PARAM int x0, int x1, int x2, int a, int typ
         }
         return D;
     }
-    /* the crossing point q on plane x_a + sign(e_a); its other coordinates
-     * are kept within one voxel of X (rounding could step past it) */
-    VEIL_PRECISE float q[3];
-    int lo[3], hi[3];
-    float f[3];
-    for (int b = 0; b < 3; ++b) {
-        if (b == a) {
-            q[b] = VEIL_FLOAT(x[b] + (e[b] > 0.0f ? 1 : -1));
-            lo[b] = VEIL_INT(q[b]);
-            hi[b] = lo[b];
-            f[b] = 0.0f;
-            continue;
-        }
-        q[b] = VEIL_FLOAT(x[b]) + e[b] * t_plane;
-        float qc = VEIL_MINF(VEIL_MAXF(q[b], VEIL_FLOAT(x[b] - 1)), VEIL_FLOAT(x[b] + 1));
-        qc = VEIL_MINF(VEIL_MAXF(qc, 0.0f), VEIL_FLOAT(VEIL_DIMS(b) - 1));
-        float fl = VEIL_FLOORF(qc);
-        lo[b] = VEIL_INT(fl);
-        f[b] = qc - fl;
-        hi[b] = f[b] > 0.0f ? lo[b] + 1 : lo[b];
-    }
-    /* bilinear over the two axes other than a (f[a] = 0, lo[a] = hi[a]) */
     VEIL_PRECISE float d00 = VEIL_DIN(lo[0], lo[1], lo[2]);
-    int b1 = a == 0 ? 1 : 0, b2 = a == 2 ? 1 : 2;
-    int i1[3], i2[3], i3[3];
-    for (int k = 0; k < 3; ++k) {
-        i1[k] = k == b1 ? hi[k] : lo[k];
-        i2[k] = k == b2 ? hi[k] : lo[k];
-        i3[k] = k == b1 || k == b2 ? hi[k] : lo[k];
-    }
     VEIL_PRECISE float d10 = VEIL_DIN(i1[0], i1[1], i1[2]);
     VEIL_PRECISE float d01 = VEIL_DIN(i2[0], i2[1], i2[2]);
     VEIL_PRECISE float d11 = VEIL_DIN(i3[0], i3[1], i3[2]);
     VEIL_PRECISE float dq = (d00 * (1.0f - f[b1]) + d10 * f[b1]) * (1.0f - f[b2]) + (d01 * (1.0f - f[b1]) + d11 * f[b1]) * f[b2];
-    VEIL_PRECISE float rq = veil_rho_clamped(VEIL_CTX_ARG q[0], q[1], q[2]);
-    VEIL_PRECISE float D = dq + h * (len * t_plane) * (0.5f * (r + rq));
-    return D;
+    VEIL_PRECISE float total = dq + D;
+    return total;
 }
 
 #endif

@@ -23,6 +23,7 @@ uniform ivec3 u_cell;
 uniform int u_shell;
 uniform int u_solve;
 uniform float u_exit_steps;
+uniform int u_characteristic;
 uniform ivec3 u_box_lo[12];
 uniform ivec3 u_box_n[12];
 
@@ -91,7 +92,8 @@ void main()
         D = veil_near_cell(x.x, x.y, x.z, u_light.x, u_light.y, u_light.z, u_voxel);
     } else {
         int a = veil_sl_axis(x.x, x.y, x.z, u_type, u_light.x, u_light.y, u_light.z, u_cell.x, u_cell.y, u_cell.z);
-        D = veil_sl_cell(x.x, x.y, x.z, a, u_type, u_light.x, u_light.y, u_light.z, u_voxel, u_exit_steps);
+        D = veil_sl_cell(x.x, x.y, x.z, a, u_type, u_light.x, u_light.y, u_light.z, u_voxel, u_characteristic,
+                         u_exit_steps);
     }
     store(x, D);
 }
