@@ -73,15 +73,15 @@ typedef struct veil_opv_params {
     veil_opv_method method;
     float tolerance;    /* Jacobi: stop when a checked step changes no D by more than this (density·m); 0: exact fixed point */
     int max_iterations; /* Jacobi: 0 = dims.x + dims.y + dims.z + 1 (enough for the exact fixed point) */
-    float exit_steps;   /* semi-Lagrangian: integrate directly when the path ends within this many
-                           voxels; 0 = VEIL_SL_DEFAULT_EXIT_STEPS, at least 1 */
+    float exit_steps;   /* semi-Lagrangian: integrate directly when the crossing point would lie within
+                           this many voxels of the path's end; 0 = VEIL_SL_DEFAULT_EXIT_STEPS, >= 1 */
     int characteristic; /* semi-Lagrangian: voxels between interpolations (1, or 2 and more);
                            0 = VEIL_SL_DEFAULT_CHARACTERISTIC */
 } veil_opv_params;
 
 /* Chosen from the measurements in docs/performance.md. */
 #define VEIL_SL_DEFAULT_EXIT_STEPS 8.0f
-#define VEIL_SL_DEFAULT_CHARACTERISTIC 4
+#define VEIL_SL_DEFAULT_CHARACTERISTIC 16
 
 static inline float veil_opv_exit_steps(const veil_opv_params* p)
 {

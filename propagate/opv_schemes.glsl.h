@@ -175,8 +175,10 @@ VEIL_FN int veil_path_end(VEIL_CTX_PARAM int y0, int y1, int y2, int type, float
  * a longer one interpolates k times less often, so it diffuses sharp
  * shadows and the kinks of D (where neighbouring rays enter the medium
  * through different faces) k times less, at k density samples a voxel.
- * If the path ends (at the medium's face, or at a point light) within
- * max(k, exit_steps) voxels along a, D is integrated to the end instead.
+ * If the crossing point would lie within `exit_steps` voxels (along a) of
+ * where the path ends (the medium's face, or a point light: where D has a
+ * kink or a cone's apex, badly interpolated), D is integrated to the end
+ * instead.
  * Needs |e_b| <= |e_a| and |e_a| >= 1 (what veil_sl_axis guarantees outside
  * the near field); the crossing point is also clamped to within k voxels
  * of X. See propagate/opv_plan.h for why the order is safe. */
@@ -200,7 +202,7 @@ VEIL_FN float veil_sl_cell(VEIL_CTX_PARAM int x0, int x1, int x2, int a, int typ
     }
     t_end = VEIL_MAXF(t_end, 0.0f);
     VEIL_PRECISE float len = VEIL_SQRTF(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-    bool direct = t_end <= VEIL_MAXF(VEIL_FLOAT(k), exit_steps) * t_voxel;
+    bool direct = t_end <= (VEIL_FLOAT(k) + exit_steps) * t_voxel;
     VEIL_PRECISE float t_stop = direct ? t_end : VEIL_FLOAT(k) * t_voxel;
     int n = direct ? VEIL_INT(VEIL_FLOORF(t_end / t_voxel)) + 1 : k;
     VEIL_PRECISE float D = 0.0f, t0 = 0.0f;
