@@ -1,7 +1,9 @@
 # Image files (io/exr.c, io/png.c): EXR round trips, foreign EXR inputs (half,
 # tiled, extra channels), failure cleanup, the PNG preview and its tone curve.
-# The test also calls OpenEXRCore and libpng directly (to inspect the files it
-# gets and to make inputs veil never writes), so it links them itself.
-veil_test(test_image SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_image.c LABELS unit)
-target_include_directories(test_image PRIVATE ${OPENEXR_INCLUDE_DIRS})
-target_link_libraries(test_image PRIVATE PkgConfig::PNG ${OPENEXRCORE_LIB})
+# The tests also call OpenEXRCore and libpng directly (to inspect the files
+# they get and to make inputs veil never writes), so they link them themselves.
+foreach(t test_exr test_png)
+  veil_test(${t} SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/${t}.c LABELS unit)
+  target_include_directories(${t} PRIVATE ${OPENEXR_INCLUDE_DIRS})
+  target_link_libraries(${t} PRIVATE PkgConfig::PNG ${OPENEXRCORE_LIB})
+endforeach()
