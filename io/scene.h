@@ -1,7 +1,7 @@
 /* veil — scene files (JSON), parsed into plain structs.
  *
  * The format is documented in docs/scene-format.md. Units: metres, m^-1 for
- * sigma_a/sigma_s (per unit density), W/sr for point-light intensity, W/m^2
+ * sigma_a/sigma_s (per unit density), W/sr for point- and spot-light intensity, W/m^2
  * for directional irradiance, degrees for the vertical field of view.
  *
  * veil_scene_load() reads a file; every error message starts with the file
