@@ -57,6 +57,16 @@
 /* Work group of the ray marcher: 8x8 pixels. */
 #define VEIL_MARCH_GROUP 8
 
+/* Outside the extinction volume the marcher's steps through fog grow with
+ * the distance travelled: this fraction of it (fog and light vary on the
+ * scale of the distance from the camera far away; the closed-form fog
+ * integral keeps each step's transmittance exact whatever its length). */
+#define VEIL_FOG_STEP_FRACTION 0.02
+
+/* At most this many exponential fogs (each is evaluated in closed form per
+ * sample, in the marcher). */
+#define VEIL_MAX_FOGS 4
+
 /* Rays stop when every channel's transmittance is below this: what is
  * dropped is at most this fraction of the light behind (the attenuated
  * background is still added with the transmittance reached). */
@@ -103,6 +113,20 @@ VEIL_FN float veil_step_integral(float x)
 {
     if (x < 0.1) return 1.0 - x * (0.5 - x * (1.0 / 6.0 - x * (1.0 / 24.0)));
     return (1.0 - VEIL_EXPF(-x)) / x;
+}
+
+/* Exponential fog, density rho0 * exp(-k) with k linear along a segment of
+ * length len from k0 to k1 (k = falloff * <x - origin, n>): the integral is
+ *   rho0 * len * exp(-min(k0, k1)) * (1 - exp(-|k1 - k0|)) / |k1 - k0|,
+ * which has no cancellation as k1 - k0 -> 0 (the series of
+ * veil_step_integral) and no overflow for large |k1 - k0| (the exponential
+ * is taken at the denser end only). The density there is capped at
+ * rho0 * exp(VEIL_FOG_MAX_EXPONENT): fog that dense is opaque anyway. */
+#define VEIL_FOG_MAX_EXPONENT 60.0
+VEIL_FN float veil_exp_fog_integral(float rho0, float k0, float k1, float len)
+{
+    float kmin = VEIL_MAXF(VEIL_MINF(k0, k1), VEIL_FLOAT(-VEIL_FOG_MAX_EXPONENT));
+    return rho0 * len * VEIL_EXPF(-kmin) * veil_step_integral(VEIL_ABSF(k1 - k0));
 }
 
 #endif

@@ -304,7 +304,11 @@ veil_result veil_scene_load(const char* path, veil_scene* out, veil_error* err)
 void veil_scene_free(veil_scene* s)
 {
     if (!s) return;
-    for (size_t i = 0; i < s->medium.source_count; ++i) free(s->medium.sources[i].particles);
+    for (size_t i = 0; i < s->medium.source_count; ++i) {
+        free(s->medium.sources[i].particles);
+        free(s->medium.sources[i].vdb.file);
+        free(s->medium.sources[i].vdb.grid);
+    }
     free(s->medium.sources);
     free(s->lights);
     free(s->path);
@@ -314,7 +318,8 @@ void veil_scene_free(veil_scene* s)
 
 static size_t source_particles(const veil_source* src)
 {
-    return src->type == VEIL_SOURCE_RBF ? src->particle_count : src->random.count;
+    if (src->type == VEIL_SOURCE_RBF) return src->particle_count;
+    return src->type == VEIL_SOURCE_RBF_RANDOM ? src->random.count : 0;
 }
 
 veil_result veil_scene_particles(const veil_scene* s, veil_particle** out,
@@ -342,7 +347,7 @@ veil_result veil_scene_particles(const veil_scene* s, veil_particle** out,
         const veil_source* src = &s->medium.sources[i];
         size_t n = source_particles(src);
         if (n && src->type == VEIL_SOURCE_RBF) memcpy(p + k, src->particles, n * sizeof *p);
-        else if (n) veil_rbf_random_generate(&src->random, p + k);
+        else if (n && src->type == VEIL_SOURCE_RBF_RANDOM) veil_rbf_random_generate(&src->random, p + k);
         k += n;
     }
     *out = p, *count = total;

@@ -42,7 +42,32 @@ typedef struct veil_phase {
     float g; /* HG asymmetry in (-1, 1); 0 for isotropic */
 } veil_phase;
 
-typedef enum veil_source_type { VEIL_SOURCE_RBF = 0, VEIL_SOURCE_RBF_RANDOM = 1 } veil_source_type;
+typedef enum veil_source_type {
+    VEIL_SOURCE_RBF = 0,
+    VEIL_SOURCE_RBF_RANDOM = 1,
+    VEIL_SOURCE_VDB = 2,
+    VEIL_SOURCE_EXPONENTIAL = 3
+} veil_source_type;
+
+/* An OpenVDB float grid ({"type":"vdb", ...}). */
+typedef struct veil_vdb_source {
+    char* file;          /* resolved against the scene's folder (owned) */
+    char* grid;          /* grid name, or NULL: "density", else the first float grid (owned) */
+    float density_scale; /* multiplies the grid's values; default 1 */
+    int level_set_to_fog; /* "level_set": "to_fog": convert a level set instead of refusing it */
+} veil_vdb_source;
+
+/* Analytic exponential (height) fog ({"type":"exponential", ...}):
+ * density(x) = density * exp(-falloff * <x - origin, direction>) inside the
+ * box `bounds` (the stated range that clips the otherwise unbounded fog),
+ * 0 outside. Never voxelised: its optical depth is the closed form. */
+typedef struct veil_exp_fog {
+    float density;      /* at the origin plane (unitless density) */
+    float falloff;      /* b, m^-1, >= 0 (0: homogeneous) */
+    float direction[3]; /* n, unit: the density falls off along it */
+    float origin[3];    /* o, m */
+    float bounds[2][3]; /* min and max corner, m */
+} veil_exp_fog;
 
 typedef struct veil_source {
     veil_source_type type;
@@ -51,7 +76,16 @@ typedef struct veil_source {
     size_t particle_count;
     /* VEIL_SOURCE_RBF_RANDOM */
     veil_rbf_random_desc random;
+    /* VEIL_SOURCE_VDB */
+    veil_vdb_source vdb;
+    /* VEIL_SOURCE_EXPONENTIAL */
+    veil_exp_fog fog;
 } veil_source;
+
+/* The default extent of exponential fog around its origin when the scene
+ * gives no bounds: a cube of this half-width (m). */
+#define VEIL_FOG_DEFAULT_HALF_EXTENT 1000.0f
+/* At most VEIL_MAX_FOGS (core/shared.glsl.h) exponential fogs. */
 
 typedef struct veil_medium {
     float sigma_a[3]; /* m^-1 per unit density, default 0 */

@@ -1,12 +1,17 @@
 /* veil — the medium's density sources in a scene file (see
  * docs/scene-format.md): explicit RBF particles, seeded random particle
- * clouds. Private to io/. */
+ * clouds, OpenVDB grids and analytic exponential fog. Private to io/. */
 #include "scene_sources.h"
 
+#include <errno.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
-static const char* const SOURCE_TYPES[] = {"rbf", "rbf_random", NULL}; /* = veil_source_type */
+static const char* const SOURCE_TYPES[] = {"rbf", "rbf_random", "vdb", "exponential", NULL}; /* = veil_source_type */
+static const char* const VDB_KEYS[] = {"type", "file", "grid", "density_scale", "level_set", NULL};
+static const char* const FOG_KEYS[] = {"type", "density", "falloff", "direction", "origin", "bounds", NULL};
 static const char* const RBF_KEYS[] = {"type", "particles", NULL};
 static const char* const RANDOM_KEYS[] = {"type", "count", "seed", "bounds", "radius", "amplitude", NULL};
 static const char* const PARTICLE_KEYS[] = {"center", "amplitude", "sharpness", NULL};
@@ -70,11 +75,93 @@ static veil_result parse_random(const ctx* c, const cJSON* so, const jpath* sp, 
     return VEIL_OK;
 }
 
+/* A string field; *out is a newly allocated copy (NULL when absent and optional). */
+static veil_result get_string(const ctx* c, const cJSON* o, const jpath* pp, const char* key, bool required,
+                              char** out)
+{
+    const jpath p = {pp, key, 0};
+    const cJSON* v;
+    *out = NULL;
+    TRY(veil__jr_lookup(c, o, &p, required, "a string", &v));
+    if (!v) return VEIL_OK;
+    if (!cJSON_IsString(v) || !v->valuestring[0]) return veil__jr_expected(c, &p, "a non-empty string", v);
+    *out = malloc(strlen(v->valuestring) + 1);
+    if (!*out) return veil_fail(c->err, VEIL_ERR_OOM, "%s: out of memory", c->name);
+    strcpy(*out, v->valuestring);
+    return VEIL_OK;
+}
+
+/* `file` resolved against the folder of the scene file, and checked readable. */
+static veil_result resolve_file(const ctx* c, const jpath* fp, char** file)
+{
+    const char* slash = strrchr(c->name, '/');
+    if ((*file)[0] != '/' && slash) {
+        size_t dir = (size_t)(slash - c->name) + 1, n = strlen(*file);
+        char* joined = malloc(dir + n + 1);
+        if (!joined) return veil_fail(c->err, VEIL_ERR_OOM, "%s: out of memory", c->name);
+        memcpy(joined, c->name, dir);
+        memcpy(joined + dir, *file, n + 1);
+        free(*file);
+        *file = joined;
+    }
+    FILE* f = fopen(*file, "rb");
+    if (!f) return veil__jr_fail_at(c, fp, "cannot open '%s': %s", *file, strerror(errno));
+    fclose(f);
+    return VEIL_OK;
+}
+
+static veil_result parse_vdb(const ctx* c, const cJSON* so, const jpath* sp, veil_vdb_source* v)
+{
+    const jpath fp = {sp, "file", 0}, lp = {sp, "level_set", 0};
+    TRY(get_string(c, so, sp, "file", true, &v->file));
+    TRY(resolve_file(c, &fp, &v->file));
+    TRY(get_string(c, so, sp, "grid", false, &v->grid));
+    double scale = 1.0;
+    TRY(veil__jr_get_number(c, so, sp, "density_scale", false, &VEIL__R_NONNEG, &scale));
+    v->density_scale = (float)scale;
+    char* ls = NULL;
+    TRY(get_string(c, so, sp, "level_set", false, &ls));
+    if (ls && strcmp(ls, "to_fog") != 0) {
+        veil_result r = veil__jr_fail_at(c, &lp, "expected \"to_fog\" (convert a level set into a fog volume), got \"%s\"", ls);
+        free(ls);
+        return r;
+    }
+    v->level_set_to_fog = ls != NULL;
+    free(ls);
+    return VEIL_OK;
+}
+
+static veil_result parse_fog(const ctx* c, const cJSON* so, const jpath* sp, veil_exp_fog* f)
+{
+    const jpath dp = {sp, "direction", 0};
+    double density, falloff;
+    TRY(veil__jr_get_number(c, so, sp, "density", true, &VEIL__R_NONNEG, &density));
+    TRY(veil__jr_get_number(c, so, sp, "falloff", true, &VEIL__R_NONNEG, &falloff));
+    f->density = (float)density, f->falloff = (float)falloff;
+    TRY(veil__jr_get_floats(c, so, sp, "direction", true, 3, false, f->direction));
+    double len = sqrt((double)f->direction[0] * f->direction[0] + (double)f->direction[1] * f->direction[1] +
+                      (double)f->direction[2] * f->direction[2]);
+    if (!(len > 0))
+        return veil__jr_fail_at(c, &dp, "expected a non-zero vector (the direction the density falls off along)");
+    for (int a = 0; a < 3; ++a) f->direction[a] = (float)(f->direction[a] / len);
+    TRY(veil__jr_get_floats(c, so, sp, "origin", true, 3, false, f->origin));
+    if (cJSON_GetObjectItemCaseSensitive(so, "bounds")) {
+        TRY(parse_bounds(c, so, sp, f->bounds));
+    } else {
+        for (int a = 0; a < 3; ++a) {
+            f->bounds[0][a] = f->origin[a] - VEIL_FOG_DEFAULT_HALF_EXTENT;
+            f->bounds[1][a] = f->origin[a] + VEIL_FOG_DEFAULT_HALF_EXTENT;
+        }
+    }
+    return VEIL_OK;
+}
+
 veil_result veil__parse_sources(const ctx* c, const cJSON* medium, const jpath* mp, veil_medium* m)
 {
+    static const char* const* const keys[] = {RBF_KEYS, RANDOM_KEYS, VDB_KEYS, FOG_KEYS}; /* by type */
     const jpath p = {mp, "sources", 0};
     const cJSON* arr, *e;
-    size_t i = 0;
+    size_t i = 0, fogs = 0;
     TRY(veil__jr_get_container(c, medium, &p, true, true, &arr));
     void* items = NULL;
     TRY(veil__jr_alloc_items(c, &p, arr, sizeof *m->sources, SIZE_MAX, &items, &m->source_count));
@@ -86,10 +173,17 @@ veil_result veil__parse_sources(const ctx* c, const cJSON* medium, const jpath* 
         if (!cJSON_IsObject(e)) return veil__jr_expected(c, &ep, "an object", e);
         TRY(veil__jr_get_kind(c, e, &ep, SOURCE_TYPES, &kind));
         src->type = (veil_source_type)kind;
-        TRY(veil__jr_check_keys(c, e, &ep, kind == VEIL_SOURCE_RBF ? RBF_KEYS : RANDOM_KEYS));
-        TRY(kind == VEIL_SOURCE_RBF ? parse_particles(c, e, &ep, src)
-                                    : parse_random(c, e, &ep, &src->random));
+        TRY(veil__jr_check_keys(c, e, &ep, keys[kind]));
+        switch (src->type) {
+        case VEIL_SOURCE_RBF: TRY(parse_particles(c, e, &ep, src)); break;
+        case VEIL_SOURCE_RBF_RANDOM: TRY(parse_random(c, e, &ep, &src->random)); break;
+        case VEIL_SOURCE_VDB: TRY(parse_vdb(c, e, &ep, &src->vdb)); break;
+        case VEIL_SOURCE_EXPONENTIAL:
+            if (++fogs > VEIL_MAX_FOGS)
+                return veil__jr_fail_at(c, &ep, "at most %d exponential fogs are supported", VEIL_MAX_FOGS);
+            TRY(parse_fog(c, e, &ep, &src->fog));
+            break;
+        }
     }
     return VEIL_OK;
 }
-

@@ -121,12 +121,20 @@ static float max_sigma_t(const veil_medium* m)
     return mx;
 }
 
-/* Does light l add anything inside the box of g? Zero colour never does; a
- * spot whose outer cone misses the box's bounding sphere does not. */
+static int count_fogs(const veil_scene* s)
+{
+    int n = 0;
+    for (size_t i = 0; i < s->medium.source_count; ++i) n += s->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL;
+    return n;
+}
+
+/* Does light l add anything inside the box of g (NULL: the medium is fog
+ * only, unbounded as far as this test goes)? Zero colour never does; a spot
+ * whose outer cone misses the box's bounding sphere does not. */
 static int light_reaches(const veil_light* l, const veil_grid* g)
 {
     if (!(l->color[0] > 0.0f || l->color[1] > 0.0f || l->color[2] > 0.0f)) return 0;
-    if (l->type != VEIL_LIGHT_SPOT || l->outer_angle_deg >= 90.0f) return 1;
+    if (!g || l->type != VEIL_LIGHT_SPOT || l->outer_angle_deg >= 90.0f) return 1;
     double c[3], d2 = 0.0, r2 = 0.0;
     for (int a = 0; a < 3; ++a) {
         double half = 0.5 * g->dims[a] * (double)g->voxel;
@@ -157,6 +165,9 @@ static veil_result make_ev(veil_renderer* r, const veil_grid* g, uint64_t key, i
 
 static veil_result inject_scene(veil_renderer* r, const veil_scene* s, veil_render_stats* st, veil_error* err)
 {
+    for (size_t i = 0; i < s->medium.source_count; ++i)
+        if (s->medium.sources[i].type == VEIL_SOURCE_VDB)
+            return veil_fail(err, VEIL_ERR_INVALID, "medium.sources[%zu]: vdb sources are read but not rendered yet", i);
     veil_particle* parts = NULL;
     size_t n = 0;
     veil_result res = veil_scene_particles(s, &parts, &n, err);
@@ -266,6 +277,32 @@ static void set_march_uniforms(GLuint p, const veil_scene* s, const veil_light* 
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_light_dir"), VEIL_MAX_LIGHTS, dir);
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_light_color"), VEIL_MAX_LIGHTS, col);
     glProgramUniform2fv(p, glGetUniformLocation(p, "u_light_cone"), VEIL_MAX_LIGHTS, cone);
+    GLint fogs = 0;
+    GLfloat fd[VEIL_MAX_FOGS] = {0}, ff[VEIL_MAX_FOGS] = {0}, fn[3 * VEIL_MAX_FOGS] = {0},
+            fo[3 * VEIL_MAX_FOGS] = {0}, flo[3 * VEIL_MAX_FOGS] = {0}, fhi[3 * VEIL_MAX_FOGS] = {0};
+    for (size_t i = 0; i < s->medium.source_count && fogs < VEIL_MAX_FOGS; ++i) {
+        const veil_source* src = &s->medium.sources[i];
+        if (src->type != VEIL_SOURCE_EXPONENTIAL) continue;
+        fd[fogs] = src->fog.density;
+        ff[fogs] = src->fog.falloff;
+        memcpy(fn + 3 * fogs, src->fog.direction, sizeof(float[3]));
+        memcpy(fo + 3 * fogs, src->fog.origin, sizeof(float[3]));
+        memcpy(flo + 3 * fogs, src->fog.bounds[0], sizeof(float[3]));
+        memcpy(fhi + 3 * fogs, src->fog.bounds[1], sizeof(float[3]));
+        ++fogs;
+    }
+    glProgramUniform1i(p, glGetUniformLocation(p, "u_fog_count"), fogs);
+    glProgramUniform1fv(p, glGetUniformLocation(p, "u_fog_density"), VEIL_MAX_FOGS, fd);
+    glProgramUniform1fv(p, glGetUniformLocation(p, "u_fog_falloff"), VEIL_MAX_FOGS, ff);
+    glProgramUniform3fv(p, glGetUniformLocation(p, "u_fog_dir"), VEIL_MAX_FOGS, fn);
+    glProgramUniform3fv(p, glGetUniformLocation(p, "u_fog_origin"), VEIL_MAX_FOGS, fo);
+    glProgramUniform3fv(p, glGetUniformLocation(p, "u_fog_min"), VEIL_MAX_FOGS, flo);
+    glProgramUniform3fv(p, glGetUniformLocation(p, "u_fog_max"), VEIL_MAX_FOGS, fhi);
+    if (!g) {
+        float md = VEIL_MIN_LIGHT_DISTANCE_VOXELS * VEIL_FOG_MIN_STEP;
+        glProgramUniform1f(p, glGetUniformLocation(p, "u_step"), VEIL_FOG_MIN_STEP);
+        glProgramUniform1f(p, glGetUniformLocation(p, "u_min_dist2"), md * md);
+    }
     GLint units[VEIL_MAX_OPV_TEXTURES];
     for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) units[t] = VEIL_TEX_OPV0 + t;
     glProgramUniform1iv(p, glGetUniformLocation(p, "u_opv"), VEIL_MAX_OPV_TEXTURES, units);
@@ -324,9 +361,10 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
     if (s->light_count > VEIL_MAX_LIGHTS)
         return veil_fail(err, VEIL_ERR_LIMIT, "%zu lights; at most %d are supported", s->light_count, VEIL_MAX_LIGHTS);
     veil_light lights[VEIL_MAX_LIGHTS];
-    int n = 0;
-    for (size_t l = 0; l < s->light_count && r->has_volume; ++l)
-        if (light_reaches(&s->lights[l], &r->grid)) lights[n++] = s->lights[l];
+    int n = 0, fogs = count_fogs(s);
+    for (size_t l = 0; l < s->light_count && (r->has_volume || fogs); ++l)
+        if (light_reaches(&s->lights[l], r->has_volume ? &r->grid : NULL)) lights[n++] = s->lights[l];
+    st->fogs = fogs;
     st->lights_used = n;
     st->method = veil_opv_method_resolve(o->method);
     st->has_volume = r->has_volume;
@@ -334,7 +372,7 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
     st->particles = r->particles;
     veil_result res = VEIL_OK;
     double t0 = veil_now_ms();
-    if (n > 0) {
+    if (n > 0 && r->has_volume) {
         res = propagate(r, s, lights, n, st->method, st, err);
         glFinish();
     }

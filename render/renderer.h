@@ -36,6 +36,9 @@
  * more than this (unitless): well under the 8-bit resolution of a preview. */
 #define VEIL_OPV_TAU_TOLERANCE 1e-4f
 
+/* The smallest march step through fog when there is no volume (m). */
+#define VEIL_FOG_MIN_STEP 0.01f
+
 /* Point lights closer than this fraction of a voxel count as this far (the
  * 1/r^2 singularity is integrable in the continuum but not in samples). */
 #define VEIL_MIN_LIGHT_DISTANCE_VOXELS 1e-3f
@@ -56,7 +59,8 @@ typedef struct veil_render_stats {
     int inject_cached;    /* the EV was reused */
     veil_grid grid;       /* the EV's geometry when has_volume */
     size_t particles;
-    int lights_used;      /* lights that reach the volume and add light */
+    int lights_used;      /* lights that reach the medium and add light */
+    int fogs;             /* analytic fogs (closed form, never voxelised) */
     int opv_computed, opv_cached; /* OPV textures made / reused */
     veil_opv_method method;
     int propagate_iterations; /* Jacobi steps or sweep passes (most of any light) */

@@ -36,6 +36,13 @@ veil_bad_input(too_many_lights ${BAD}/too_many_lights.json "too_many_lights.json
 # refused with the numbers before anything is allocated.
 veil_bad_input(volume_too_large ${BAD}/volume_too_large.json
                "volume_too_large.json: a 2048x2048x2048 extinction volume with 16 lights needs")
+veil_bad_input(fog_negative_falloff ${BAD}/fog_negative_falloff.json
+               "fog_negative_falloff.json: medium.sources[0].falloff: expected a number >= 0, got -1")
+veil_bad_input(fog_zero_direction ${BAD}/fog_zero_direction.json
+               "fog_zero_direction.json: medium.sources[0].direction: expected a non-zero vector")
+# a relative VDB path resolves against the scene's folder, and the message shows where it looked
+veil_bad_input(vdb_missing_file ${BAD}/vdb_missing_file.json
+               "vdb_missing_file.json: medium.sources[0].file: cannot open '${BAD}/no_such_smoke.vdb'")
 veil_bad_input(missing_file ${BAD}/does_not_exist.json "does_not_exist.json: cannot open: No such file or directory")
 veil_bad_input(directory ${BAD} "bad: cannot read: Is a directory")
 veil_bad_input(spot_inner_ge_outer ${BAD}/spot_inner_ge_outer.json

@@ -206,7 +206,7 @@ static const bad_case BAD[] = {
     {"{" CAM ",'medium':{'sigma_s':[1,1,1]}}", VEIL_ERR_INVALID, "medium.sources",
      "missing required field (an array)"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[" SRC_OK ",{'particles':[]}]}}", VEIL_ERR_INVALID,
-     "medium.sources[1].type", "missing required field (one of \"rbf\", \"rbf_random\")"},
+     "medium.sources[1].type", "missing required field (one of \"rbf\", \"rbf_random\", \"vdb\", \"exponential\")"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[" SRC_OK ",7]}}", VEIL_ERR_INVALID,
      "medium.sources[1]", "expected an object, got 7"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'rbf','particles':["

@@ -1,0 +1,222 @@
+// veil tests — writes the OpenVDB files that tests/test_vdb.c and
+// tests/vdb_cli.sh read, so that no binary test data is committed.
+//
+//   make_test_vdbs DIR           the test files (below), deterministic
+//   make_test_vdbs DIR --big     also big_plume.vdb (~10^6 active voxels, for timing)
+//
+// Files (grid name, what it is for):
+//   fog_sphere.vdb       "density": createLevelSetSphere + sdfToFogVolume
+//   level_set.vdb        "surface": a narrow-band level set sphere (refused unless converted)
+//   vec3.vdb             "velocity": a Vec3f grid (refused, naming its type)
+//   empty.vdb            "density": a float grid with no active voxel
+//   offset_scaled.vdb    "density": voxel 0.25 m, translated by (1, -2, 3); the linear field
+//                        1 + i/2 + j/4 + k/8 on the index block [0, 15]^3 (pins the convention)
+//   rotated.vdb          "density": a Gaussian blob under scale + rotation + translation
+//   frustum.vdb          "density": a frustum (non-affine) transform
+//   two_grids.vdb        "temperature" then "density" (written without stats metadata)
+//   smoke_plume.vdb      "density": a procedural noisy plume, ~10^5 active voxels, hard edges
+//   truncated.vdb        the first half of fog_sphere.vdb's bytes
+//   garbage.vdb          bytes that are not an OpenVDB file
+//
+// The values that tests/test_vdb.c recomputes (the linear field, the two
+// grids' voxel counts) are stated in the comments next to them.
+#include <openvdb/openvdb.h>
+#include <openvdb/io/File.h>
+#include <openvdb/tools/LevelSetSphere.h>
+#include <openvdb/tools/LevelSetUtil.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+using openvdb::Coord;
+using openvdb::FloatGrid;
+
+namespace {
+
+std::string g_dir;
+
+std::string path(const char* name) { return g_dir + "/" + name; }
+
+void write(const char* name, openvdb::GridPtrVec grids, bool stats = true)
+{
+    openvdb::io::File file(path(name));
+    file.setGridStatsMetadataEnabled(stats);
+    file.write(grids);
+    file.close();
+}
+
+FloatGrid::Ptr float_grid(const char* name, double voxel)
+{
+    FloatGrid::Ptr g = FloatGrid::create(0.0f);
+    g->setName(name);
+    g->setGridClass(openvdb::GRID_FOG_VOLUME);
+    g->setTransform(openvdb::math::Transform::createLinearTransform(voxel));
+    return g;
+}
+
+// Deterministic lattice hash in [0, 1): an integer mix of the three
+// coordinates and a seed (multiply-xorshift rounds).
+double hash01(int x, int y, int z, uint32_t seed)
+{
+    uint32_t h = seed ^ (uint32_t)x * 0x8da6b343u ^ (uint32_t)y * 0xd8163841u ^ (uint32_t)z * 0xcb1ab31fu;
+    h ^= h >> 16;
+    h *= 0x7feb352du;
+    h ^= h >> 15;
+    h *= 0x846ca68bu;
+    h ^= h >> 16;
+    return (double)h / 4294967296.0;
+}
+
+// Value noise: the lattice hash, trilinearly blended with a smoothstep weight.
+double value_noise(double x, double y, double z, uint32_t seed)
+{
+    int x0 = (int)std::floor(x), y0 = (int)std::floor(y), z0 = (int)std::floor(z);
+    double fx = x - x0, fy = y - y0, fz = z - z0;
+    fx = fx * fx * (3 - 2 * fx);
+    fy = fy * fy * (3 - 2 * fy);
+    fz = fz * fz * (3 - 2 * fz);
+    double v = 0.0;
+    for (int c = 0; c < 8; ++c) {
+        int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
+        double w = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
+        v += w * hash01(x0 + dx, y0 + dy, z0 + dz, seed);
+    }
+    return v;
+}
+
+// A rising plume in index space, `s` times the base size (height 100 s
+// voxels, radius 10 s at the bottom to 25 s at the top, drifting in x),
+// whose density is a radial fall-off times three octaves of value noise;
+// voxels below 0.05 are left inactive (a hard edge, as smoke caches have).
+FloatGrid::Ptr plume(double s)
+{
+    FloatGrid::Ptr g = float_grid("density", 0.02);
+    FloatGrid::Accessor acc = g->getAccessor();
+    const int height = (int)std::lround(100 * s);
+    const double cutoff = 0.05;
+    for (int y = 0; y < height; ++y) {
+        double t = (double)y / height;
+        double r = s * (10.0 + 15.0 * t), cx = 4.0 * s * std::sin(6.0 * t);
+        int ri = (int)std::ceil(r);
+        for (int z = -ri; z <= ri; ++z)
+            for (int x = (int)std::floor(cx) - ri; x <= (int)std::ceil(cx) + ri; ++x) {
+                double d = std::sqrt((x - cx) * (x - cx) + (double)z * z) / r;
+                if (d >= 1.0) continue;
+                double n = 0.0, amp = 0.5, f = 1.0 / (6.0 * s);
+                for (int o = 0; o < 3; ++o, amp *= 0.5, f *= 2.0)
+                    n += amp * value_noise(x * f, y * f, z * f, 17u + (uint32_t)o);
+                double v = (1.0 - d * d) * (0.3 + 1.4 * n) * (1.0 - 0.5 * t);
+                if (v > cutoff) acc.setValue(Coord(x, y, z), (float)v);
+            }
+    }
+    return g;
+}
+
+void copy_prefix(const char* from, const char* to, double fraction)
+{
+    std::ifstream in(path(from), std::ios::binary);
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream out(path(to), std::ios::binary);
+    out.write(bytes.data(), (std::streamsize)(bytes.size() * fraction));
+    if (!out) throw std::runtime_error(std::string("cannot write ") + path(to));
+}
+
+void make_all(bool big)
+{
+    const float sphere_voxel = 0.05f, sphere_radius = 1.0f; // 20 voxels
+    FloatGrid::Ptr ls = openvdb::tools::createLevelSetSphere<FloatGrid>(sphere_radius, openvdb::Vec3f(0.1f, -0.2f, 0.3f),
+                                                                         sphere_voxel);
+    ls->setName("surface");
+    write("level_set.vdb", {ls});
+
+    FloatGrid::Ptr fog = ls->deepCopy();
+    openvdb::tools::sdfToFogVolume(*fog);
+    fog->setName("density");
+    write("fog_sphere.vdb", {fog});
+    copy_prefix("fog_sphere.vdb", "truncated.vdb", 0.5);
+
+    openvdb::Vec3SGrid::Ptr vel = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+    vel->setName("velocity");
+    for (int i = 0; i < 8; ++i) vel->tree().setValue(Coord(i, 0, 0), openvdb::Vec3s(1.0f, 0.0f, (float)i));
+    write("vec3.vdb", {vel});
+
+    write("empty.vdb", {float_grid("density", 0.1)});
+
+    // The linear field 1 + i/2 + j/4 + k/8 on [0, 15]^3, voxel 0.25 m,
+    // index (0,0,0) at world (1, -2, 3): voxel (i,j,k)'s centre is at
+    // (1 + i/4, -2 + j/4, 3 + k/4).
+    FloatGrid::Ptr lin = float_grid("density", 0.25);
+    lin->transform().postTranslate(openvdb::Vec3d(1.0, -2.0, 3.0));
+    {
+        FloatGrid::Accessor acc = lin->getAccessor();
+        for (int k = 0; k < 16; ++k)
+            for (int j = 0; j < 16; ++j)
+                for (int i = 0; i < 16; ++i) acc.setValue(Coord(i, j, k), 1.0f + i / 2.0f + j / 4.0f + k / 8.0f);
+    }
+    write("offset_scaled.vdb", {lin});
+
+    // A Gaussian blob (sigma 5 voxels, cut at 4 sigma) under voxel 0.05 m,
+    // rotated 30 deg about z then 20 deg about x, then moved to (0.5, 0.25, -1).
+    FloatGrid::Ptr rot = float_grid("density", 0.05);
+    rot->transform().postRotate(30.0 * M_PI / 180.0, openvdb::math::Z_AXIS);
+    rot->transform().postRotate(20.0 * M_PI / 180.0, openvdb::math::X_AXIS);
+    rot->transform().postTranslate(openvdb::Vec3d(0.5, 0.25, -1.0));
+    {
+        FloatGrid::Accessor acc = rot->getAccessor();
+        const double sigma = 5.0;
+        for (int k = -20; k <= 20; ++k)
+            for (int j = -20; j <= 20; ++j)
+                for (int i = -20; i <= 20; ++i) {
+                    double r2 = (double)i * i + (double)j * j + (double)k * k;
+                    if (r2 <= 16.0 * sigma * sigma) acc.setValue(Coord(i, j, k), (float)std::exp(-0.5 * r2 / (sigma * sigma)));
+                }
+    }
+    write("rotated.vdb", {rot});
+
+    FloatGrid::Ptr fr = float_grid("density", 1.0);
+    fr->setTransform(openvdb::math::Transform::createFrustumTransform(
+        openvdb::BBoxd(openvdb::Vec3d(0.0), openvdb::Vec3d(15.0)), 0.5, 2.0, 1.0));
+    fr->tree().setValue(Coord(1, 2, 3), 1.0f);
+    write("frustum.vdb", {fr});
+
+    // "temperature" first (3 active voxels), then "density" (5 active voxels).
+    FloatGrid::Ptr temp = float_grid("temperature", 0.1), dens = float_grid("density", 0.1);
+    for (int i = 0; i < 3; ++i) temp->tree().setValue(Coord(i, 0, 0), 300.0f);
+    for (int i = 0; i < 5; ++i) dens->tree().setValue(Coord(0, i, 0), 0.5f);
+    write("two_grids.vdb", {temp, dens}, false);
+
+    write("smoke_plume.vdb", {plume(1.0)});
+    if (big) write("big_plume.vdb", {plume(2.2)});
+
+    std::ofstream garbage(path("garbage.vdb"), std::ios::binary);
+    for (int i = 0; i < 64; ++i) garbage << "this is not an OpenVDB file\n";
+    if (!garbage) throw std::runtime_error("cannot write " + path("garbage.vdb"));
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    if (argc < 2 || argc > 3 || (argc == 3 && std::strcmp(argv[2], "--big") != 0)) {
+        std::fprintf(stderr, "usage: %s DIR [--big]\n", argv[0]);
+        return 2;
+    }
+    g_dir = argv[1];
+    try {
+        std::filesystem::create_directories(g_dir);
+        openvdb::initialize();
+        make_all(argc == 3);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "make_test_vdbs: %s\n", e.what());
+        return 1;
+    }
+    std::printf("wrote the test VDB files into %s\n", g_dir.c_str());
+    return 0;
+}
