@@ -93,7 +93,7 @@ veil_grid bench_grid(int n)
 float* make_medium(int medium, const veil_grid* g, veil_error* err)
 {
     size_t nv = veil_grid_voxels(g);
-    float* rho = malloc(nv * sizeof(float));
+    float* rho = calloc(nv, sizeof(float));
     if (!rho) {
         veil_fail(err, VEIL_ERR_OOM, "out of memory for a %zu-voxel medium", nv);
         return NULL;

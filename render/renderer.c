@@ -153,10 +153,12 @@ static int light_reaches(const veil_light* l, const veil_grid* g)
 
 static veil_result make_ev(veil_renderer* r, const veil_grid* g, uint64_t key, int n_lights, veil_error* err)
 {
+    static const GLfloat zero = 0.0f;
     drop_volume(r);
     veil_result res = check_volume_size(r, g, n_lights, err);
     if (res == VEIL_OK) res = veil_gl_texture3d(GL_R32F, g->dims, "veil extinction volume", &r->ev, err);
     if (res != VEIL_OK) return res;
+    glClearTexImage(r->ev, 0, GL_RED, GL_FLOAT, &zero); /* sources add to it */
     r->grid = *g;
     r->has_volume = 1;
     r->ev_key = key;
@@ -436,7 +438,11 @@ veil_result veil_renderer_inject(veil_renderer* r, const veil_grid* g, const vei
     GLuint ev = 0;
     veil_result res = veil_rbf_bin(g, p, n, &bins, err);
     if (res == VEIL_OK) res = veil_gl_texture3d(GL_R32F, g->dims, "veil extinction volume", &ev, err);
-    if (res == VEIL_OK) res = veil_inject_rbf_gpu(r->inject, g, &bins, ev, err);
+    if (res == VEIL_OK) {
+        static const GLfloat zero = 0.0f;
+        glClearTexImage(ev, 0, GL_RED, GL_FLOAT, &zero);
+        res = veil_inject_rbf_gpu(r->inject, g, &bins, ev, err);
+    }
     if (res == VEIL_OK) res = read_texture(ev, GL_RED, veil_grid_voxels(g), density, "reading back the EV", err);
     glDeleteTextures(1, &ev);
     veil_rbf_bins_free(&bins);

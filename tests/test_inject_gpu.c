@@ -31,7 +31,7 @@ int main(void)
     veil_grid g;
     veil_grid_fit(lo, hi, 37, &g, &err);
     size_t nv = veil_grid_voxels(&g);
-    float* cpu = malloc(nv * sizeof(float));
+    float* cpu = calloc(nv, sizeof(float));
     float* gpu = malloc(nv * sizeof(float));
     veil_rbf_bins bins;
     veil_rbf_bin(&g, p, d.count, &bins, &err);

@@ -84,7 +84,7 @@ static void test_sweep_is_fixed_point(void)
     veil_rbf_bins bins;
     veil_error err = {0};
     veil_rbf_bin(&g, p, d.count, &bins, &err);
-    float* rho = malloc(nv * sizeof(float));
+    float* rho = calloc(nv, sizeof(float));
     veil_inject_rbf_cpu(&g, &bins, rho);
     veil_rbf_bins_free(&bins);
     const veil_light world[3] = {

@@ -30,7 +30,7 @@ int main(void)
     veil_rbf_random_generate(&d, p);
     veil_rbf_bins bins;
     veil_rbf_bin(&g, p, d.count, &bins, &err);
-    float* rho = malloc(nv * sizeof(float));
+    float* rho = calloc(nv, sizeof(float));
     veil_inject_rbf_cpu(&g, &bins, rho);
     veil_rbf_bins_free(&bins);
 

@@ -81,7 +81,7 @@ static void test_splat(void)
     veil_grid_fit(lo, hi, 40, &g, &err);
     veil_rbf_bins bins;
     CHECK(veil_rbf_bin(&g, p, d.count, &bins, &err) == VEIL_OK, "%s", err.msg);
-    float* rho = malloc(veil_grid_voxels(&g) * sizeof(float));
+    float* rho = calloc(veil_grid_voxels(&g), sizeof(float));
     veil_inject_rbf_cpu(&g, &bins, rho);
     double worst = 0.0;
     int bad = 0;

@@ -300,7 +300,7 @@ static float* splat(const veil_particle* p, size_t n, int res, veil_grid* g)
         fprintf(stderr, "splat failed: %s\n", err.msg);
         return NULL;
     }
-    float* rho = malloc(veil_grid_voxels(g) * sizeof(float));
+    float* rho = calloc(veil_grid_voxels(g), sizeof(float));
     if (rho) veil_inject_rbf_cpu(g, &bins, rho);
     veil_rbf_bins_free(&bins);
     return rho;

@@ -19,7 +19,7 @@ veil_result veil_inject_rbf_gpu(GLuint program, const veil_grid* g, const veil_r
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_PARTICLES, buf[0]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_BRICK_START, buf[1]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_BRICK_LIST, buf[2]);
-        glBindImageTexture(VEIL_IMAGE_EV, ev_texture, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindImageTexture(VEIL_IMAGE_EV, ev_texture, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
         glDispatchCompute((GLuint)b->bricks[0], (GLuint)b->bricks[1], (GLuint)b->bricks[2]);
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                         GL_TEXTURE_UPDATE_BARRIER_BIT);

@@ -1,5 +1,5 @@
-/* veil — the RBF splat on the GPU (volume/shaders/inject_rbf.comp): fills an
- * r32f 3D texture of the grid's size from binned particles, exactly as
+/* veil — the RBF splat on the GPU (volume/shaders/inject_rbf.comp): adds
+ * binned particles to an r32f 3D texture of the grid's size, exactly as
  * veil_inject_rbf_cpu() does. Needs a current GL context. */
 #ifndef VEIL_INJECT_GPU_H
 #define VEIL_INJECT_GPU_H

@@ -164,13 +164,14 @@ void veil_inject_rbf_cpu(const veil_grid* g, const veil_rbf_bins* b, float* rho)
                                i / VEIL_BRICK;
                 float x[3];
                 veil_grid_center(g, i, j, k, x);
-                float sum = 0.0f;
+                size_t out = ((size_t)k * g->dims[1] + j) * g->dims[0] + i;
+                float sum = rho[out];
                 for (uint32_t e = b->start[brick]; e < b->start[brick + 1]; ++e) {
                     const float* q = b->packed + 8 * (size_t)b->list[e];
                     float dx = x[0] - q[0], dy = x[1] - q[1], dz = x[2] - q[2];
                     float r2 = dx * dx + dy * dy + dz * dz;
                     if (r2 <= q[5]) sum += q[3] * expf(-(q[4] * r2));
                 }
-                rho[((size_t)k * g->dims[1] + j) * g->dims[0] + i] = sum;
+                rho[out] = sum;
             }
 }

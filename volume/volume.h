@@ -57,7 +57,7 @@ veil_result veil_rbf_bin(const veil_grid* g, const veil_particle* p, size_t n,
                          veil_rbf_bins* out, veil_error* err);
 void veil_rbf_bins_free(veil_rbf_bins* b);
 
-/* CPU splat: rho (veil_grid_voxels floats, x fastest) = sum of particles. */
+/* CPU splat: adds the particles to rho (veil_grid_voxels floats, x fastest). */
 void veil_inject_rbf_cpu(const veil_grid* g, const veil_rbf_bins* b, float* rho);
 
 #endif

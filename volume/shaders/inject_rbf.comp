@@ -1,6 +1,7 @@
-// veil — RBF splat into the extinction volume (density, r32f).
+// veil — RBF splat into the extinction volume (density, r32f), added to
+// what the volume holds (zero, or density from other sources).
 // One work group per VEIL_BRICK^3 brick; each invocation is one voxel and
-// sums the Gaussians of its brick's particle list, in list order. Mirrors
+// adds the Gaussians of its brick's particle list, in list order. Mirrors
 // veil_inject_rbf_cpu() operation for operation; `precise` forbids fused
 // multiply-adds so that the cut-off test r^2 <= r_cut^2 decides exactly as
 // in C.
@@ -13,7 +14,7 @@ struct Particle {
 layout(std430, binding = VEIL_BIND_PARTICLES) readonly buffer Particles { Particle particles[]; };
 layout(std430, binding = VEIL_BIND_BRICK_START) readonly buffer BrickStart { uint brick_start[]; };
 layout(std430, binding = VEIL_BIND_BRICK_LIST) readonly buffer BrickList { uint brick_list[]; };
-layout(binding = VEIL_IMAGE_EV, r32f) writeonly uniform image3D u_ev;
+layout(binding = VEIL_IMAGE_EV, r32f) uniform image3D u_ev;
 
 uniform ivec3 u_dims;
 uniform ivec3 u_bricks;
@@ -27,7 +28,7 @@ void main()
     ivec3 b = ivec3(gl_WorkGroupID);
     uint brick = uint((b.z * u_bricks.y + b.y) * u_bricks.x + b.x);
     precise vec3 x = u_origin + (vec3(v) + 0.5) * u_voxel;
-    precise float sum = 0.0;
+    precise float sum = imageLoad(u_ev, v).r;
     uint end = brick_start[brick + 1u];
     for (uint e = brick_start[brick]; e < end; ++e) {
         Particle p = particles[brick_list[e]];
