@@ -1,6 +1,9 @@
 /* veil benchmarks — the deterministic media the benchmarks measure on. */
 #include "media.h"
 
+#include "io/vdb.h"
+#include "volume/vdb_volume.h"
+
 #include <math.h>
 #include <stdlib.h>
 
@@ -114,6 +117,25 @@ float* make_medium(int medium, const veil_grid* g, veil_error* err)
         }
         veil_inject_rbf_cpu(g, &bins, rho);
         veil_rbf_bins_free(&bins);
+    } else if (medium == MEDIUM_VDB_SMOKE) {
+        const char* path = getenv("VEIL_BENCH_VDB") ? getenv("VEIL_BENCH_VDB") : VEIL_BENCH_DEFAULT_VDB;
+        veil_vdb* v = NULL;
+        float lo[3], hi[3];
+        veil_result r = veil_vdb_open(path, NULL, 0, &v, NULL, 0, err);
+        if (r == VEIL_OK) r = veil_vdb_world_support(v, lo, hi, err);
+        if (r == VEIL_OK) {
+            /* the cube enclosing the grid, with the bench grid's dims */
+            float side = fmaxf(hi[0] - lo[0], fmaxf(hi[1] - lo[1], hi[2] - lo[2]));
+            veil_grid cube = *g;
+            cube.voxel = side / (float)(g->dims[0] - 1);
+            for (int a = 0; a < 3; ++a) cube.origin[a] = 0.5f * (lo[a] + hi[a]) - 0.5f * (float)g->dims[a] * cube.voxel;
+            r = veil_vdb_to_grid(v, 1.0f, &cube, rho, err);
+        }
+        veil_vdb_close(v);
+        if (r != VEIL_OK) {
+            free(rho);
+            return NULL;
+        }
     } else {
         for (int k = 0; k < g->dims[2]; ++k)
             for (int j = 0; j < g->dims[1]; ++j)

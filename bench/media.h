@@ -4,7 +4,12 @@
  *  - rbf-fog: a seeded RBF particle cloud splatted on the grid on the CPU;
  *  - smoke: a procedural smoke plume (a bent rising column, radius growing
  *    with height, modulated by seeded value-noise fBm) — a STAND-IN for a
- *    real OpenVDB smoke volume until the OpenVDB reader lands. */
+ *    real OpenVDB smoke volume;
+ *  - smoke-vdb: a real smoke VDB (default ../shared/data/smoke.vdb beside the
+ *    checkout, or $VEIL_BENCH_VDB), its "density" grid resampled with mass
+ *    conservation onto the N^3 grid over the cube enclosing it, then used on
+ *    the bench's box: a uniformly scaled copy (relative errors do not change
+ *    with scale). Missing file: make_medium fails with VEIL_ERR_IO. */
 #ifndef VEIL_BENCH_MEDIA_H
 #define VEIL_BENCH_MEDIA_H
 
@@ -14,7 +19,7 @@
 #define BOX_LO (-1.0f)
 #define BOX_WIDTH 2.0f
 
-enum { MEDIUM_HOMOGENEOUS, MEDIUM_RBF_FOG, MEDIUM_SMOKE, MEDIUM_COUNT };
+enum { MEDIUM_HOMOGENEOUS, MEDIUM_RBF_FOG, MEDIUM_SMOKE, MEDIUM_VDB_SMOKE, MEDIUM_COUNT };
 
 veil_grid bench_grid(int n);
 /* The density of `medium` on g (veil_grid_voxels floats, x fastest); NULL on

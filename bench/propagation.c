@@ -1,6 +1,7 @@
 /* veil — run time against error of the optical-depth propagation methods.
  *
  *   propagation [--quick] [--runs N] [--sizes 64,128,256] [--methods a,b]
+ *               [--media homogeneous,rbf-fog,smoke,smoke-vdb] [--methods-only]
  *               [--jacobi-256] [--csv FILE]
  *
  * For every grid size N (an N^3 grid over the same 2 m box), medium and
@@ -60,7 +61,7 @@
 #define MAX_SIZES 8
 #define REPEAT_LIMIT_MS 15000.0 /* a case whose first run takes longer is not repeated */
 
-static const char* const medium_names[MEDIUM_COUNT] = {"homogeneous", "rbf-fog", "smoke"};
+static const char* const medium_names[MEDIUM_COUNT] = {"homogeneous", "rbf-fog", "smoke", "smoke-vdb"};
 
 enum { LIGHT_INSIDE, LIGHT_OUTSIDE, LIGHT_DIRECTIONAL, LIGHT_COUNT };
 static const char* const light_names[LIGHT_COUNT] = {"inside", "outside", "directional"};
@@ -354,7 +355,7 @@ static void print_medium_note(int medium, const prepared* p)
 
 static void usage(FILE* f)
 {
-    fprintf(f, "usage: propagation [--quick] [--runs N] [--sizes 64,128,256] [--methods a,b] [--jacobi-256] "
+    fprintf(f, "usage: propagation [--quick] [--runs N] [--sizes 64,128,256] [--methods a,b] [--media a,b] [--methods-only] [--jacobi-256] "
                "[--csv FILE]\n  methods: jacobi, jacobi-corrected, sweep, semi-lagrangian\n");
 }
 
@@ -372,6 +373,8 @@ int main(int argc, char** argv)
 {
     int sizes[MAX_SIZES] = {64, 128, 256}, n_sizes = 3, runs_opt = 0, quick = 0, jacobi256 = 0;
     int use_method[VEIL_OPV_METHOD_COUNT] = {0, 1, 1, 1, 1};
+    int use_medium[MEDIUM_COUNT] = {1, 1, 1, 1};
+    int methods_only = 0; /* --methods-only: skip the per-light and knob tables */
     const char* csv_path = NULL;
     int sizes_given = 0;
     for (int a = 1; a < argc; ++a) {
@@ -419,6 +422,22 @@ int main(int argc, char** argv)
                 use_method[veil_opv_method_resolve(m)] = 1;
             }
             ++a;
+        } else if (strcmp(arg, "--media") == 0 && val) {
+            char buf[256];
+            snprintf(buf, sizeof buf, "%s", val);
+            memset(use_medium, 0, sizeof use_medium);
+            for (char* tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+                int found = 0;
+                for (int m = 0; m < MEDIUM_COUNT; ++m)
+                    if (strcmp(tok, medium_names[m]) == 0) use_medium[m] = found = 1;
+                if (!found) {
+                    fprintf(stderr, "propagation: --media: unknown medium '%s'\n", tok);
+                    return 2;
+                }
+            }
+            ++a;
+        } else if (strcmp(arg, "--methods-only") == 0) {
+            methods_only = 1;
         } else if (strcmp(arg, "--csv") == 0 && val) {
             csv_path = val;
             ++a;
@@ -503,8 +522,14 @@ int main(int argc, char** argv)
         int runs = b.runs ? b.runs : (n >= 256 ? 1 : 3);
         for (int m = 0; m < MEDIUM_COUNT && status == 0; ++m) {
             fprintf(stderr, "[%d^3 %s] building the medium\n", n, medium_names[m]);
+            if (!use_medium[m]) continue;
             prepared p;
-            if (prepare(m, n, 1, &p, &err) != VEIL_OK) {
+            veil_result pr = prepare(m, n, 1, &p, &err);
+            if (pr == VEIL_ERR_IO && m == MEDIUM_VDB_SMOKE) { /* a third-party file: optional */
+                printf("# %-11s %4d^3: skipped: %s\n", medium_names[m], n, err.msg);
+                continue;
+            }
+            if (pr != VEIL_OK) {
                 fprintf(stderr, "propagation: %d^3 %s: %s\n", n, medium_names[m], err.msg);
                 status = 1;
                 break;
@@ -570,7 +595,7 @@ int main(int argc, char** argv)
     if (ref_line[0]) printf("%s\n", ref_line);
 
     /* ---- table 2: cost per light, default method, rbf-fog ----------------- */
-    if (status == 0) {
+    if (status == 0 && !methods_only) {
         veil_opv_method def = veil_opv_method_resolve(VEIL_OPV_DEFAULT);
         int runs = b.runs ? b.runs : 3;
         printf("\n## per-light cost: %s (the default), %d^3, rbf-fog, point lights at seeded positions in "
@@ -616,7 +641,7 @@ int main(int argc, char** argv)
     }
 
     /* ---- table 3: semi-Lagrangian quality knobs ----------------------------- */
-    if (status == 0) {
+    if (status == 0 && !methods_only) {
         /* (characteristic, exit_steps): each knob around the defaults (16, 8) */
         static const int chars[] = {1, 2, 4, 8, 16, 16, 16, 16};
         static const float steps[] = {8, 8, 8, 8, 8, 1, 16, 32};

@@ -3,6 +3,7 @@
  *   veil render SCENE.json -o OUT.exr [--png OUT.png] [--width W] [--height H]
  *               [--step S] [--seed N] [--method M] [--turntable N] [--stats]
  *   veil gpuinfo
+ *   veil info FILE.vdb [--json]
  *   veil --help | --version
  *
  * Exit codes: 0 success, 1 bad input (scene, file), 2 usage, 3 GPU/driver.
@@ -20,6 +21,7 @@
 
 #include "io/image.h"
 #include "io/scene.h"
+#include "io/vdb.h"
 #include "render/gl_context.h"
 #include "render/gl_util.h"
 #include "render/renderer.h"
@@ -30,6 +32,7 @@ static const char* usage_text =
     "usage: veil render SCENE.json -o OUT.exr [--png OUT.png] [--width W] [--height H]\n"
     "                   [--step S] [--seed N] [--method M] [--turntable N] [--stats]\n"
     "       veil gpuinfo\n"
+    "       veil info FILE.vdb [--json]\n"
     "       veil --help | --version\n"
     "\n"
     "render   renders a scene (docs/scene-format.md) to an HDR EXR (R, G, B, A = 1 - mean\n"
@@ -47,6 +50,9 @@ static const char* usage_text =
     "  --stats        print the wall time of each stage in milliseconds\n"
     "gpuinfo  prints the EGL platform and device, GL vendor, renderer, version and\n"
     "         the largest 3D texture. VEIL_DEVICE=software forces llvmpipe.\n"
+    "info     lists the grids of an OpenVDB file: name, class, value type, active\n"
+    "         voxels, index and world bounding boxes, voxel size and transform.\n"
+    "  --json         print them as JSON instead of a table\n"
     "\n"
     "exit codes: 0 success, 1 bad input, 2 usage, 3 GPU or driver failure\n";
 
@@ -116,6 +122,69 @@ static int cmd_gpuinfo(void)
     printf("GL version:        %s\n", i->version);
     printf("max 3D texture:    %d\n", i->max_3d_texture_size);
     veil_gl_destroy(gl);
+    return EXIT_OK;
+}
+
+static void print_info_grid(const veil_vdb_grid_info* g)
+{
+    printf("\ngrid '%s'\n", g->name);
+    if (g->active_voxels == 0) {
+        printf("  index bbox   (empty)\n");
+    } else {
+        printf("  index bbox   [%d, %d, %d] .. [%d, %d, %d]  (%d x %d x %d)\n", g->index_lo[0], g->index_lo[1],
+               g->index_lo[2], g->index_hi[0], g->index_hi[1], g->index_hi[2], g->index_hi[0] - g->index_lo[0] + 1,
+               g->index_hi[1] - g->index_lo[1] + 1, g->index_hi[2] - g->index_lo[2] + 1);
+        if (g->affine)
+            printf("  world bbox   [%g, %g, %g] .. [%g, %g, %g] m\n", g->world_lo[0], g->world_lo[1], g->world_lo[2],
+                   g->world_hi[0], g->world_hi[1], g->world_hi[2]);
+    }
+    printf("  transform    %s%s\n", g->map_type, g->affine ? " (index to world, column vectors)" : " (not affine)");
+    for (int r = 0; g->affine && r < 4; ++r)
+        printf("               [%10.6g %10.6g %10.6g %10.6g]\n", g->index_to_world[r][0], g->index_to_world[r][1],
+               g->index_to_world[r][2], g->index_to_world[r][3]);
+}
+
+static int cmd_info(int argc, char** argv)
+{
+    const char* path = NULL;
+    int json = 0;
+    for (int i = 2; i < argc; ++i) {
+        if (!strcmp(argv[i], "--json")) json = 1;
+        else if (argv[i][0] == '-' && argv[i][1]) return usage_error("unknown option '%s'", argv[i]);
+        else if (!path) path = argv[i];
+        else return usage_error("unexpected argument '%s'", argv[i]);
+    }
+    if (!path) return usage_error("%s", "info: missing FILE.vdb");
+    veil_error err = {0};
+    if (json) {
+        char* text = NULL;
+        veil_result r = veil_vdb_info_json(path, &text, &err);
+        if (r != VEIL_OK) return fail(r, &err);
+        puts(text);
+        free(text);
+        return EXIT_OK;
+    }
+    veil_vdb_grid_info* grids = NULL;
+    size_t n = 0;
+    veil_result r = veil_vdb_file_info(path, &grids, &n, &err);
+    if (r != VEIL_OK) return fail(r, &err);
+    int w = 4; /* name column: the longest name */
+    for (size_t i = 0; i < n; ++i) w = (int)strlen(grids[i].name) > w ? (int)strlen(grids[i].name) : w;
+    printf("%s: %zu grid%s\n\n", path, n, n == 1 ? "" : "s");
+    printf("  %-*s  %-10s  %-8s  %13s  %s\n", w, "name", "class", "type", "active voxels", "voxel size (m)");
+    for (size_t i = 0; i < n; ++i) {
+        const veil_vdb_grid_info* g = &grids[i];
+        char vs[96];
+        if (fabs(g->voxel_size[0] - g->voxel_size[1]) <= 1e-9 * g->voxel_size[0] &&
+            fabs(g->voxel_size[1] - g->voxel_size[2]) <= 1e-9 * g->voxel_size[0]) /* uniform, up to rounding */
+            snprintf(vs, sizeof vs, "%g", g->voxel_size[0]);
+        else
+            snprintf(vs, sizeof vs, "%g x %g x %g", g->voxel_size[0], g->voxel_size[1], g->voxel_size[2]);
+        printf("  %-*s  %-10s  %-8s  %13llu  %s\n", w, g->name, g->grid_class, g->value_type,
+               (unsigned long long)g->active_voxels, vs);
+    }
+    for (size_t i = 0; i < n; ++i) print_info_grid(&grids[i]);
+    veil_vdb_file_info_free(grids, n);
     return EXIT_OK;
 }
 
@@ -218,10 +287,10 @@ static void print_stats(const veil_render_stats* st, size_t lights, int w, int h
     if (st->inject_cached)
         printf("  (cached)\n");
     else if (st->has_volume)
-        printf("  (%zu particles, grid %dx%dx%d, voxel %.4g m)\n", st->particles, st->grid.dims[0], st->grid.dims[1],
-               st->grid.dims[2], st->grid.voxel);
+        printf("  (%zu particles, %zu VDB voxels, grid %dx%dx%d, voxel %.4g m)\n", st->particles, st->vdb_voxels,
+               st->grid.dims[0], st->grid.dims[1], st->grid.dims[2], st->grid.voxel);
     else
-        printf("  (empty medium: no volume)\n");
+        printf("  (no voxelised source: no volume%s)\n", st->fogs ? "; analytic fog only" : "");
     printf("propagate  %9.2f ms", st->propagate_ms);
     if (st->lights_used == 0)
         printf("  (no light reaches the medium: skipped)\n");
@@ -303,6 +372,7 @@ int main(int argc, char** argv)
         return EXIT_OK;
     }
     if (!strcmp(cmd, "render")) return cmd_render(argc, argv);
+    if (!strcmp(cmd, "info")) return cmd_info(argc, argv);
     if (!strcmp(cmd, "gpuinfo")) {
         if (argc > 2) return usage_error("gpuinfo takes no arguments, got '%s'", argv[2]);
         return cmd_gpuinfo();

@@ -36,6 +36,9 @@
  * more than this (unitless): well under the 8-bit resolution of a preview. */
 #define VEIL_OPV_TAU_TOLERANCE 1e-4f
 
+/* At most this many OpenVDB grids in one scene. */
+#define VEIL_MAX_VDB_SOURCES 8
+
 /* The smallest march step through fog when there is no volume (m). */
 #define VEIL_FOG_MIN_STEP 0.01f
 
@@ -59,6 +62,7 @@ typedef struct veil_render_stats {
     int inject_cached;    /* the EV was reused */
     veil_grid grid;       /* the EV's geometry when has_volume */
     size_t particles;
+    size_t vdb_voxels;    /* active voxels of the OpenVDB grids (0 when cached) */
     int lights_used;      /* lights that reach the medium and add light */
     int fogs;             /* analytic fogs (closed form, never voxelised) */
     int opv_computed, opv_cached; /* OPV textures made / reused */

@@ -13,6 +13,7 @@
 //                        1 + i/2 + j/4 + k/8 on the index block [0, 15]^3 (pins the convention)
 //   rotated.vdb          "density": a Gaussian blob under scale + rotation + translation
 //   frustum.vdb          "density": a frustum (non-affine) transform
+//   far_apart.vdb        "density": two voxels at index (0,0,0) and (1100,1100,1100)
 //   two_grids.vdb        "temperature" then "density" (written without stats metadata)
 //   smoke_plume.vdb      "density": a procedural noisy plume, ~10^5 active voxels, hard edges
 //   truncated.vdb        the first half of fog_sphere.vdb's bytes
@@ -185,6 +186,13 @@ void make_all(bool big)
         openvdb::BBoxd(openvdb::Vec3d(0.0), openvdb::Vec3d(15.0)), 0.5, 2.0, 1.0));
     fr->tree().setValue(Coord(1, 2, 3), 1.0f);
     write("frustum.vdb", {fr});
+
+    // Two voxels 1100 apart on each axis: a dense index box of 1103^3 =
+    // 1.34e9 values (with the zero ring), over VEIL_VDB_MAX_DENSE_VOXELS.
+    FloatGrid::Ptr far = float_grid("density", 0.1);
+    far->tree().setValue(Coord(0, 0, 0), 1.0f);
+    far->tree().setValue(Coord(1100, 1100, 1100), 1.0f);
+    write("far_apart.vdb", {far});
 
     // "temperature" first (3 active voxels), then "density" (5 active voxels).
     FloatGrid::Ptr temp = float_grid("temperature", 0.1), dens = float_grid("density", 0.1);

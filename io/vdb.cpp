@@ -1,0 +1,429 @@
+// veil — the OpenVDB reader (io/vdb.h): the only C++ in veil.
+//
+// Every extern "C" function runs its body inside guarded(), which catches
+// every exception and turns it into a veil_result and a message; nothing
+// C++ crosses the header. Files are opened without delayed loading, so the
+// grid is read completely (and a truncated file fails) inside veil_vdb_open,
+// never later from a memory-mapped file.
+#include "vdb.h"
+
+#include <openvdb/openvdb.h>
+#include <openvdb/io/File.h>
+#include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/LevelSetUtil.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cJSON.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <new>
+#include <string>
+
+using openvdb::Coord;
+using openvdb::CoordBBox;
+using openvdb::FloatGrid;
+using openvdb::GridBase;
+
+struct veil_vdb {
+    std::string path, name;
+    FloatGrid::Ptr grid;         // read-only once opened
+    CoordBBox active_box;        // computed once: the grid does not change
+    openvdb::Index64 active = 0;
+};
+
+namespace {
+
+// Points sampled per parallel task: large enough to amortise a task and its
+// value accessor, small enough to balance over cores.
+constexpr size_t SAMPLE_GRAIN = 4096;
+
+// A failure whose message is already written for the user.
+struct failure {
+    veil_result code;
+    std::string msg;
+};
+
+[[noreturn]] void fail_with(veil_result code, std::string msg) { throw failure{code, std::move(msg)}; }
+
+std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+// Runs f, mapping every exception to a result: `what` prefixes the messages
+// of exceptions thrown by OpenVDB or the standard library (normally the file).
+template <typename F>
+veil_result guarded(veil_error* err, const char* what, F&& f) noexcept
+{
+    try {
+        f();
+        return VEIL_OK;
+    } catch (const failure& e) {
+        return veil_fail(err, e.code, "%s", e.msg.c_str());
+    } catch (const std::bad_alloc&) {
+        return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory while reading the OpenVDB file", what);
+    } catch (const openvdb::Exception& e) {
+        return veil_fail(err, VEIL_ERR_IO, "%s: cannot read the OpenVDB file (OpenVDB said: %s)", what, e.what());
+    } catch (const std::exception& e) {
+        return veil_fail(err, VEIL_ERR_IO, "%s: cannot read the OpenVDB file (%s)", what, e.what());
+    } catch (...) {
+        return veil_fail(err, VEIL_ERR_IO, "%s: cannot read the OpenVDB file (unknown C++ exception)", what);
+    }
+}
+
+void init_openvdb()
+{
+    static std::once_flag once;
+    std::call_once(once, [] { openvdb::initialize(); });
+}
+
+// The file must exist and be a regular file; OpenVDB's own message for a
+// missing file does not say why.
+void check_readable(const std::string& path)
+{
+    struct stat st;
+    if (stat(path.c_str(), &st) != 0) fail_with(VEIL_ERR_IO, path + ": cannot open: " + std::strerror(errno));
+    if (S_ISDIR(st.st_mode)) fail_with(VEIL_ERR_IO, path + ": cannot read: Is a directory");
+}
+
+// Opens the file with delayed loading off (everything is read now).
+void open_file(openvdb::io::File& file, const std::string& path)
+{
+    init_openvdb();
+    check_readable(path);
+    file.open(false);
+}
+
+std::string class_name(const GridBase& g)
+{
+    switch (g.getGridClass()) {
+    case openvdb::GRID_LEVEL_SET: return "level set";
+    case openvdb::GRID_FOG_VOLUME: return "fog volume";
+    case openvdb::GRID_STAGGERED: return "staggered";
+    default: return "unknown";
+    }
+}
+
+// "temperature (float, fog volume), velocity (vec3s, unknown)"
+std::string list_grids(const openvdb::GridPtrVec& grids)
+{
+    std::string s;
+    for (const auto& g : grids) {
+        if (!s.empty()) s += ", ";
+        s += quoted(g->getName()) + " (" + g->valueType() + ", " + class_name(*g) + ")";
+    }
+    return s.empty() ? "no grids" : s;
+}
+
+// The grid to load: the named one, or the default (see vdb.h).
+GridBase::Ptr choose(const std::string& path, const openvdb::GridPtrVec& grids, const char* want)
+{
+    if (want) {
+        for (const auto& g : grids)
+            if (g->getName() == want) return g;
+        fail_with(VEIL_ERR_INVALID, path + ": no grid named " + quoted(want) + "; the file has " + list_grids(grids));
+    }
+    for (const auto& g : grids)
+        if (g->getName() == VEIL_VDB_DEFAULT_GRID) return g;
+    for (const auto& g : grids)
+        if (g->isType<FloatGrid>()) return g;
+    fail_with(VEIL_ERR_INVALID, path + ": no float grid to read (veil reads a scalar float density grid, by default "
+                                       "the one named '" VEIL_VDB_DEFAULT_GRID "'); the file has " + list_grids(grids));
+}
+
+// Inactive values (voxels, tiles, background) become 0: only active voxels
+// carry density. Fog volumes already have this form.
+void zero_inactive(FloatGrid& grid)
+{
+    FloatGrid::TreeType& tree = grid.tree();
+    if (tree.background() != 0.0f) tree.root().setBackground(0.0f, true);
+    for (FloatGrid::ValueOffIter it = grid.beginValueOff(); it; ++it)
+        if (*it != 0.0f) it.setValue(0.0f);
+}
+
+void to_column_matrix(const openvdb::math::Transform& t, double m[4][4])
+{
+    const openvdb::Mat4d a = t.baseMap()->getAffineMap()->getMat4(); // row vectors: world = idx * a
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) m[r][c] = a(c, r);
+}
+
+// World AABB of the 8 corners of an index box under an affine map.
+void world_box(const double m[4][4], const CoordBBox& b, double lo[3], double hi[3])
+{
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = HUGE_VAL;
+        hi[a] = -HUGE_VAL;
+    }
+    for (int c = 0; c < 8; ++c) {
+        const double p[3] = {(double)(c & 1 ? b.max().x() : b.min().x()), (double)(c & 2 ? b.max().y() : b.min().y()),
+                             (double)(c & 4 ? b.max().z() : b.min().z())};
+        for (int r = 0; r < 3; ++r) {
+            double w = m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3];
+            lo[r] = std::min(lo[r], w);
+            hi[r] = std::max(hi[r], w);
+        }
+    }
+}
+
+void copy_name(const std::string& s, char* out, size_t len)
+{
+    if (!out || len == 0) return;
+    size_t n = std::min(s.size(), len - 1);
+    std::memcpy(out, s.data(), n);
+    out[n] = '\0';
+}
+
+char* dup_c(const std::string& s)
+{
+    char* p = static_cast<char*>(std::malloc(s.size() + 1));
+    if (!p) throw std::bad_alloc();
+    std::memcpy(p, s.c_str(), s.size() + 1);
+    return p;
+}
+
+void fill_info(openvdb::io::File& file, const GridBase& meta, veil_vdb_grid_info& gi)
+{
+    gi.name = dup_c(meta.getName());
+    copy_name(class_name(meta), gi.grid_class, sizeof gi.grid_class);
+    copy_name(meta.valueType(), gi.value_type, sizeof gi.value_type);
+
+    CoordBBox box;
+    openvdb::Index64 count = 0;
+    // The statistics OpenVDB writes by default (absent, or of another
+    // type, in files written otherwise: then the tree is read).
+    const auto bmin = meta.getMetadata<openvdb::Vec3IMetadata>(GridBase::META_FILE_BBOX_MIN);
+    const auto bmax = meta.getMetadata<openvdb::Vec3IMetadata>(GridBase::META_FILE_BBOX_MAX);
+    const auto cnt = meta.getMetadata<openvdb::Int64Metadata>(GridBase::META_FILE_VOXEL_COUNT);
+    if (bmin && bmax && cnt) {
+        count = (openvdb::Index64)cnt->value();
+        box = CoordBBox(Coord(bmin->value()), Coord(bmax->value()));
+    } else { // written without statistics: read the tree
+        GridBase::Ptr g = file.readGrid(meta.getName());
+        count = g->activeVoxelCount();
+        box = g->evalActiveVoxelBoundingBox();
+    }
+    gi.active_voxels = count;
+    for (int a = 0; a < 3; ++a) {
+        gi.index_lo[a] = count ? box.min()[a] : 0;
+        gi.index_hi[a] = count ? box.max()[a] : -1;
+    }
+
+    const openvdb::math::Transform& t = meta.transform();
+    const openvdb::Vec3d vs = t.voxelSize();
+    for (int a = 0; a < 3; ++a) gi.voxel_size[a] = vs[a];
+    copy_name(t.baseMap()->type(), gi.map_type, sizeof gi.map_type);
+    gi.affine = t.baseMap()->isLinear() ? 1 : 0;
+    if (gi.affine) {
+        to_column_matrix(t, gi.index_to_world);
+        if (count) world_box(gi.index_to_world, box, gi.world_lo, gi.world_hi);
+    }
+}
+
+cJSON* json_ints(const int v[3])
+{
+    return cJSON_CreateIntArray(v, 3);
+}
+
+cJSON* json_doubles(const double v[3])
+{
+    return cJSON_CreateDoubleArray(v, 3);
+}
+
+cJSON* json_pair(cJSON* a, cJSON* b)
+{
+    cJSON* p = cJSON_CreateArray();
+    cJSON_AddItemToArray(p, a);
+    cJSON_AddItemToArray(p, b);
+    return p;
+}
+
+cJSON* grid_json(const veil_vdb_grid_info& g)
+{
+    cJSON* o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "name", g.name);
+    cJSON_AddStringToObject(o, "class", g.grid_class);
+    cJSON_AddStringToObject(o, "value_type", g.value_type);
+    cJSON_AddNumberToObject(o, "active_voxels", (double)g.active_voxels);
+    const bool empty = g.active_voxels == 0;
+    cJSON_AddItemToObject(o, "index_bbox", empty ? cJSON_CreateNull() : json_pair(json_ints(g.index_lo), json_ints(g.index_hi)));
+    cJSON_AddItemToObject(o, "world_bbox", empty || !g.affine ? cJSON_CreateNull()
+                                                              : json_pair(json_doubles(g.world_lo), json_doubles(g.world_hi)));
+    cJSON_AddItemToObject(o, "voxel_size", json_doubles(g.voxel_size));
+    cJSON_AddStringToObject(o, "map_type", g.map_type);
+    if (g.affine) {
+        cJSON* m = cJSON_CreateArray();
+        for (int r = 0; r < 4; ++r) cJSON_AddItemToArray(m, cJSON_CreateDoubleArray(g.index_to_world[r], 4));
+        cJSON_AddItemToObject(o, "transform", m);
+    } else {
+        cJSON_AddItemToObject(o, "transform", cJSON_CreateNull());
+    }
+    return o;
+}
+
+} // namespace
+
+extern "C" {
+
+veil_result veil_vdb_open(const char* path, const char* grid_name, int level_set_to_fog, veil_vdb** out,
+                          char* chosen_name, size_t chosen_len, veil_error* err)
+{
+    if (out) *out = nullptr;
+    if (!path || !out) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_open: path and out are required");
+    veil_vdb* v = nullptr;
+    veil_result r = guarded(err, path, [&] {
+        openvdb::io::File file(path);
+        open_file(file, path);
+        openvdb::GridPtrVec metas = *file.readAllGridMetadata();
+        GridBase::Ptr meta = choose(path, metas, grid_name);
+        const std::string name = meta->getName(), where = std::string(path) + ": grid " + quoted(name);
+        if (!meta->isType<FloatGrid>())
+            fail_with(VEIL_ERR_INVALID, where + " has value type " + meta->valueType() +
+                                            "; veil reads only float grids (a scalar density)");
+        if (meta->getGridClass() == openvdb::GRID_LEVEL_SET && !level_set_to_fog)
+            fail_with(VEIL_ERR_INVALID,
+                      where + " is a level set (a signed distance to a surface, not a density); add \"level_set\": "
+                              "\"to_fog\" to the vdb source to convert it into a fog volume when it is read, or "
+                              "convert the file with vdb_tool -ls2fog");
+        FloatGrid::Ptr grid = openvdb::gridPtrCast<FloatGrid>(file.readGrid(name));
+        file.close();
+        if (!grid) fail_with(VEIL_ERR_IO, where + ": OpenVDB returned no float grid");
+        if (grid->getGridClass() == openvdb::GRID_LEVEL_SET) openvdb::tools::sdfToFogVolume(*grid);
+        zero_inactive(*grid);
+        v = new veil_vdb{path, name, grid, grid->evalActiveVoxelBoundingBox(), grid->activeVoxelCount()};
+    });
+    if (r != VEIL_OK) return r;
+    copy_name(v->name, chosen_name, chosen_len);
+    *out = v;
+    return VEIL_OK;
+}
+
+void veil_vdb_close(veil_vdb* v)
+{
+    delete v; // destructors of shared_ptr and std::string do not throw
+}
+
+const char* veil_vdb_path(const veil_vdb* v) { return v ? v->path.c_str() : ""; }
+const char* veil_vdb_grid_name(const veil_vdb* v) { return v ? v->name.c_str() : ""; }
+
+veil_result veil_vdb_transform(const veil_vdb* v, double index_to_world[4][4], veil_error* err)
+{
+    if (!v) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_transform: no grid");
+    return guarded(err, v->path.c_str(), [&] {
+        const openvdb::math::Transform& t = v->grid->transform();
+        if (!t.baseMap()->isLinear())
+            fail_with(VEIL_ERR_INVALID, v->path + ": grid " + quoted(v->name) + " has a non-affine transform (" +
+                                            t.baseMap()->type() +
+                                            "); veil reads grids whose index-to-world map is affine (scale, rotation, "
+                                            "shear, translation), not frustum or other nonlinear maps");
+        to_column_matrix(t, index_to_world);
+    });
+}
+
+veil_result veil_vdb_index_bbox(const veil_vdb* v, int lo[3], int hi[3], size_t* active_voxels)
+{
+    if (!v) return VEIL_ERR_INVALID;
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = v->active ? v->active_box.min()[a] : 0;
+        hi[a] = v->active ? v->active_box.max()[a] : -1;
+    }
+    if (active_voxels) *active_voxels = (size_t)v->active;
+    return VEIL_OK;
+}
+
+veil_result veil_vdb_sample_world(const veil_vdb* v, const double* xyz, size_t n, float* out, veil_error* err)
+{
+    if (!v || (n && (!xyz || !out))) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_sample_world: missing argument");
+    return guarded(err, v->path.c_str(), [&] {
+        const FloatGrid& grid = *v->grid;
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, SAMPLE_GRAIN), [&](const tbb::blocked_range<size_t>& r) {
+            FloatGrid::ConstAccessor acc = grid.getConstAccessor(); // one per task: accessors cache, so are not shared
+            openvdb::tools::GridSampler<FloatGrid::ConstAccessor, openvdb::tools::BoxSampler> s(acc, grid.transform());
+            for (size_t i = r.begin(); i != r.end(); ++i)
+                out[i] = s.wsSample(openvdb::Vec3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]));
+        });
+    });
+}
+
+veil_result veil_vdb_dense(const veil_vdb* v, const int lo[3], const int hi[3], float* out)
+{
+    if (!v || !lo || !hi || !out) return VEIL_ERR_INVALID;
+    size_t d[3];
+    for (int a = 0; a < 3; ++a) {
+        if (hi[a] < lo[a]) return VEIL_ERR_INVALID;
+        d[a] = (size_t)((long long)hi[a] - lo[a] + 1);
+    }
+    size_t total;
+    if (!veil_mul_sizes(d[0], d[1], d[2], sizeof(float), &total)) return VEIL_ERR_LIMIT;
+    return guarded(nullptr, v->path.c_str(), [&] {
+        FloatGrid::ConstAccessor acc = v->grid->getConstAccessor();
+        size_t i = 0;
+        for (int z = lo[2]; z <= hi[2]; ++z)
+            for (int y = lo[1]; y <= hi[1]; ++y)
+                for (int x = lo[0]; x <= hi[0]; ++x) out[i++] = acc.getValue(Coord(x, y, z));
+    });
+}
+
+veil_result veil_vdb_file_info(const char* path, veil_vdb_grid_info** grids, size_t* count, veil_error* err)
+{
+    if (!path || !grids || !count) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_file_info: missing argument");
+    *grids = nullptr;
+    *count = 0;
+    veil_vdb_grid_info* out = nullptr;
+    size_t n = 0;
+    veil_result r = guarded(err, path, [&] {
+        openvdb::io::File file(path);
+        open_file(file, path);
+        openvdb::GridPtrVec metas = *file.readAllGridMetadata();
+        out = static_cast<veil_vdb_grid_info*>(std::calloc(metas.size() ? metas.size() : 1, sizeof *out));
+        if (!out) throw std::bad_alloc();
+        for (const auto& m : metas) fill_info(file, *m, out[n++]);
+        file.close();
+    });
+    if (r != VEIL_OK) {
+        veil_vdb_file_info_free(out, n);
+        return r;
+    }
+    *grids = out;
+    *count = n;
+    return VEIL_OK;
+}
+
+void veil_vdb_file_info_free(veil_vdb_grid_info* grids, size_t count)
+{
+    if (!grids) return;
+    for (size_t i = 0; i < count; ++i) std::free(grids[i].name);
+    std::free(grids);
+}
+
+veil_result veil_vdb_info_json(const char* path, char** json_out, veil_error* err)
+{
+    if (!json_out) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_info_json: json_out is required");
+    *json_out = nullptr;
+    veil_vdb_grid_info* grids = nullptr;
+    size_t n = 0;
+    veil_result r = veil_vdb_file_info(path, &grids, &n, err);
+    if (r != VEIL_OK) return r;
+    cJSON* root = cJSON_CreateObject();
+    cJSON* arr = cJSON_CreateArray();
+    if (root && arr) {
+        cJSON_AddStringToObject(root, "file", path);
+        cJSON_AddItemToObject(root, "grids", arr);
+        arr = nullptr;
+        for (size_t i = 0; i < n; ++i) cJSON_AddItemToArray(cJSON_GetObjectItem(root, "grids"), grid_json(grids[i]));
+        *json_out = cJSON_Print(root);
+    }
+    cJSON_Delete(arr);
+    cJSON_Delete(root);
+    veil_vdb_file_info_free(grids, n);
+    if (!*json_out) return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory while writing the grid summary", path);
+    return VEIL_OK;
+}
+
+} // extern "C"

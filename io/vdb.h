@@ -1,0 +1,112 @@
+/* veil — the OpenVDB reader: one float grid from a .vdb file, its index-to-
+ * world transform, trilinear samples of it, and a summary of every grid in a
+ * file (`veil info`).
+ *
+ * Convention (OpenVDB's, which vdb_render follows): the value of voxel
+ * (i, j, k) is a sample at the integer index point (i, j, k), which lies at
+ * world M * (i, j, k, 1) under the grid's affine map M; the field between
+ * samples is their trilinear interpolation (openvdb::tools::BoxSampler).
+ * (Blender Cycles 3.4 places the samples half a voxel off from this.) World
+ * units are the file's, taken as metres. Values are unitless density; the
+ * values of inactive voxels and tiles and the background are read as 0
+ * (a fog volume's inactive region is empty space).
+ *
+ * Ownership: veil_vdb_open makes a veil_vdb that owns a copy of the grid
+ * (the file is read completely and closed before it returns);
+ * veil_vdb_close frees it. A veil_vdb is read-only after opening, so any
+ * number of threads may sample one at once. Strings returned by the info
+ * functions are malloc'd and freed by the caller (or by
+ * veil_vdb_file_info_free). The implementation is C++ (io/vdb.cpp); no
+ * exception leaves it: each one becomes a result code and a message that
+ * names the file and says what OpenVDB said.
+ */
+#ifndef VEIL_VDB_H
+#define VEIL_VDB_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#include "../core/result.h"
+
+/* One loaded float grid (opaque). */
+typedef struct veil_vdb veil_vdb;
+
+/* The grid chosen when the caller names none: this one if the file has it,
+ * else the file's first float grid, in the order OpenVDB lists a file's
+ * grids (by name, not by position in the file). */
+#define VEIL_VDB_DEFAULT_GRID "density"
+
+/* Opens `path` and loads one float grid: `grid_name`, or when NULL the
+ * default above. Writes the chosen grid's name into chosen_name (chosen_len
+ * bytes, truncated; may be NULL). A level set is refused unless
+ * level_set_to_fog is set, which converts it into a fog volume
+ * (openvdb::tools::sdfToFogVolume: 0 outside, rising to 1 over the interior
+ * narrow band, 1 inside).
+ * Errors: VEIL_ERR_IO (missing, unreadable, corrupt or truncated file),
+ * VEIL_ERR_INVALID (no such grid: the message lists the file's grids; not
+ * a float grid: it names the value type; a level set without the flag),
+ * VEIL_ERR_OOM. */
+veil_result veil_vdb_open(const char* path, const char* grid_name, int level_set_to_fog, veil_vdb** out,
+                          char* chosen_name, size_t chosen_len, veil_error* err);
+/* Accepts NULL. */
+void veil_vdb_close(veil_vdb* v);
+
+/* The file and grid name, for messages (owned by v). */
+const char* veil_vdb_path(const veil_vdb* v);
+const char* veil_vdb_grid_name(const veil_vdb* v);
+
+/* The affine index-to-world map as a 4x4 matrix acting on column vectors:
+ * world[r] = sum_c m[r][c] * (i, j, k, 1)[c]; the last row is 0 0 0 1.
+ * VEIL_ERR_INVALID for a non-affine map (a frustum, or any nonlinear one). */
+veil_result veil_vdb_transform(const veil_vdb* v, double index_to_world[4][4], veil_error* err);
+
+/* The inclusive index box [lo, hi] of the active voxels and tiles, and their
+ * number. An empty grid gives active 0, lo = (0,0,0), hi = (-1,-1,-1). */
+veil_result veil_vdb_index_bbox(const veil_vdb* v, int lo[3], int hi[3], size_t* active_voxels);
+
+/* The trilinear field at n world points (xyz: 3n doubles, x y z per point)
+ * into out (n floats); 0 away from the active voxels. Runs in parallel (TBB)
+ * with one value accessor per task. */
+veil_result veil_vdb_sample_world(const veil_vdb* v, const double* xyz, size_t n, float* out, veil_error* err);
+
+/* The values at the integer index points of the inclusive box [lo, hi] into
+ * out, x fastest then y then z ((hi-lo+1) product floats, caller's).
+ * VEIL_ERR_INVALID if hi < lo on an axis; VEIL_ERR_LIMIT if the count does
+ * not fit in size_t. */
+veil_result veil_vdb_dense(const veil_vdb* v, const int lo[3], const int hi[3], float* out);
+
+/* One grid of a file, as `veil info` shows it. */
+typedef struct veil_vdb_grid_info {
+    char* name;            /* owned */
+    char grid_class[16];   /* "fog volume", "level set", "staggered" or "unknown" */
+    char value_type[32];   /* OpenVDB's name: "float", "double", "vec3s", ... */
+    uint64_t active_voxels;
+    int index_lo[3], index_hi[3]; /* inclusive active box; lo > hi when empty */
+    double world_lo[3], world_hi[3]; /* AABB of the active box's corner samples (m); affine only */
+    double voxel_size[3];  /* world length of one index step along each index axis (m) */
+    int affine;            /* 1: index_to_world holds the map; 0: map_type names the nonlinear map */
+    char map_type[32];     /* OpenVDB's map name, e.g. "UniformScaleTranslateMap", "NonlinearFrustumMap" */
+    double index_to_world[4][4]; /* as veil_vdb_transform */
+} veil_vdb_grid_info;
+
+/* Reads the metadata and transforms of every grid in `path` (and a grid's
+ * tree only when the file lacks its bounding-box statistics). */
+veil_result veil_vdb_file_info(const char* path, veil_vdb_grid_info** grids, size_t* count, veil_error* err);
+void veil_vdb_file_info_free(veil_vdb_grid_info* grids, size_t count);
+
+/* The same as a JSON document (malloc'd, free() it):
+ * {"file": ..., "grids": [{"name", "class", "value_type", "active_voxels",
+ *  "index_bbox": [[lo],[hi]] or null, "world_bbox": [[lo],[hi]] or null,
+ *  "voxel_size": [3], "map_type", "transform": the 4 rows of the
+ *  index-to-world matrix of veil_vdb_transform, or null when not affine}]} */
+veil_result veil_vdb_info_json(const char* path, char** json_out, veil_error* err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
