@@ -2,10 +2,11 @@
 #   make        configure and build into build/ (the tool is build/veil)
 #   make demo   install missing packages, build, render the demo scene
 #   make test   install missing packages, build, run every test (ctest)
+#   make data   generate the smoke VDB that data/scenes/vdb_smoke.json renders
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
-.PHONY: all deps build demo test clean
+.PHONY: all deps build demo test data clean
 
 all: build
 
@@ -28,6 +29,11 @@ test:
 	@$(MAKE) --no-print-directory deps
 	@$(MAKE) --no-print-directory build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+data:
+	@$(MAKE) --no-print-directory deps
+	@$(MAKE) --no-print-directory build
+	@$(BUILD)/tests/make_test_vdbs --plume data/generated/smoke_plume.vdb
 
 clean:
 	rm -rf $(BUILD) out

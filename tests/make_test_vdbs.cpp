@@ -3,6 +3,8 @@
 //
 //   make_test_vdbs DIR           the test files (below), deterministic
 //   make_test_vdbs DIR --big     also big_plume.vdb (~10^6 active voxels, for timing)
+//   make_test_vdbs --plume FILE  only the plume, at the size of big_plume.vdb, into FILE
+//                                (the example scene data/scenes/vdb_smoke.json: `make data`)
 //
 // Files (grid name, what it is for):
 //   fog_sphere.vdb       "density": createLevelSetSphere + sdfToFogVolume
@@ -212,8 +214,22 @@ void make_all(bool big)
 
 int main(int argc, char** argv)
 {
+    if (argc == 3 && std::strcmp(argv[1], "--plume") == 0) {
+        std::filesystem::path file(argv[2]);
+        g_dir = file.has_parent_path() ? file.parent_path().string() : std::string(".");
+        try {
+            std::filesystem::create_directories(g_dir);
+            openvdb::initialize();
+            write(file.filename().string().c_str(), {plume(2.2)});
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "make_test_vdbs: %s\n", e.what());
+            return 1;
+        }
+        std::printf("wrote %s\n", argv[2]);
+        return 0;
+    }
     if (argc < 2 || argc > 3 || (argc == 3 && std::strcmp(argv[2], "--big") != 0)) {
-        std::fprintf(stderr, "usage: %s DIR [--big]\n", argv[0]);
+        std::fprintf(stderr, "usage: %s DIR [--big] | --plume FILE\n", argv[0]);
         return 2;
     }
     g_dir = argv[1];
