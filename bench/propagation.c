@@ -369,8 +369,26 @@ static int parse_int(const char* s, int lo, int hi, int* out)
     return 1;
 }
 
+/* Marks use[i] for each comma-separated name in `list` found in names[];
+ * 0 when one is not found. */
+static int select_names(const char* list, const char* const* names, int count, int* use)
+{
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", list);
+    memset(use, 0, (size_t)count * sizeof *use);
+    for (char* tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        int found = 0;
+        for (int i = 0; i < count; ++i)
+            if (strcmp(tok, names[i]) == 0) use[i] = found = 1;
+        if (!found) return 0;
+    }
+    return 1;
+}
+
 int main(int argc, char** argv)
 {
+    const char* method_names[VEIL_OPV_METHOD_COUNT];
+    for (int m = 0; m < VEIL_OPV_METHOD_COUNT; ++m) method_names[m] = veil_opv_method_name((veil_opv_method)m);
     int sizes[MAX_SIZES] = {64, 128, 256}, n_sizes = 3, runs_opt = 0, quick = 0, jacobi256 = 0;
     int use_method[VEIL_OPV_METHOD_COUNT] = {0, 1, 1, 1, 1};
     int use_medium[MEDIUM_COUNT] = {1, 1, 1, 1};
@@ -408,32 +426,13 @@ int main(int argc, char** argv)
             }
             sizes_given = 1;
             ++a;
-        } else if (strcmp(arg, "--methods") == 0 && val) {
-            char buf[256];
-            snprintf(buf, sizeof buf, "%s", val);
-            memset(use_method, 0, sizeof use_method);
-            for (char* tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
-                veil_opv_method m;
-                if (!veil_opv_method_parse(tok, &m)) {
-                    fprintf(stderr, "propagation: --methods: unknown method '%s'\n", tok);
-                    usage(stderr);
-                    return 2;
-                }
-                use_method[veil_opv_method_resolve(m)] = 1;
-            }
-            ++a;
-        } else if (strcmp(arg, "--media") == 0 && val) {
-            char buf[256];
-            snprintf(buf, sizeof buf, "%s", val);
-            memset(use_medium, 0, sizeof use_medium);
-            for (char* tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
-                int found = 0;
-                for (int m = 0; m < MEDIUM_COUNT; ++m)
-                    if (strcmp(tok, medium_names[m]) == 0) use_medium[m] = found = 1;
-                if (!found) {
-                    fprintf(stderr, "propagation: --media: unknown medium '%s'\n", tok);
-                    return 2;
-                }
+        } else if ((strcmp(arg, "--methods") == 0 || strcmp(arg, "--media") == 0) && val) {
+            int media = strcmp(arg, "--media") == 0;
+            if (!select_names(val, media ? medium_names : method_names, media ? MEDIUM_COUNT : VEIL_OPV_METHOD_COUNT,
+                              media ? use_medium : use_method)) {
+                fprintf(stderr, "propagation: %s %s: unknown name\n", arg, val);
+                usage(stderr);
+                return 2;
             }
             ++a;
         } else if (strcmp(arg, "--methods-only") == 0) {
