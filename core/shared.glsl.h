@@ -84,6 +84,7 @@
 #define VEIL_IMAGE_OUT 3        /* image unit: rgba32f output image */
 #define VEIL_TEX_EV 0           /* texture unit: sampled EV */
 #define VEIL_TEX_OPV0 1         /* texture units 1..4: sampled OPVs */
+#define VEIL_TEX_OCC 5          /* texture unit: occupancy bricks (max density per brick) */
 
 /* Henyey–Greenstein phase function (sr^-1), cos_theta the cosine between the
  * light's travel direction and the scattered direction; g = 0 is isotropic

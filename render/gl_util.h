@@ -18,6 +18,7 @@ extern const char veil_shader_propagate_jacobi_comp[];
 extern const char veil_shader_propagate_sweep_comp[];
 extern const char veil_shader_opv_schemes_glsl_h[];
 extern const char veil_shader_march_comp[];
+extern const char veil_shader_occupancy_comp[];
 
 /* Compiles and links a compute program: "#version 450", VEIL_GLSL, the
  * shared header, then `source`, where a line `//@include NAME` is replaced

@@ -14,12 +14,12 @@
 #include "gl_util.h"
 
 struct veil_renderer {
-    GLuint inject, march;
+    GLuint inject, march, occupancy;
     veil_opv_programs opv_programs;
     unsigned long long memory_budget; /* bytes, see veil_gl_info */
     /* the cached extinction volume and what it was made from */
     uint64_t ev_key;
-    GLuint ev;
+    GLuint ev, occ; /* the volume, and its occupancy bricks */
     int has_volume;
     veil_grid grid;
     size_t particles;
@@ -53,6 +53,9 @@ veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_er
     if (res == VEIL_OK) res = veil_opv_programs_create(&r->opv_programs, err);
     if (res == VEIL_OK)
         res = veil_gl_compute_program("render/shaders/march.comp", veil_shader_march_comp, &r->march, err);
+    if (res == VEIL_OK)
+        res = veil_gl_compute_program("render/shaders/occupancy.comp", veil_shader_occupancy_comp, &r->occupancy,
+                                      err);
     if (res != VEIL_OK) {
         veil_renderer_destroy(r);
         return res;
@@ -71,7 +74,8 @@ static void drop_opvs(veil_renderer* r)
 static void drop_volume(veil_renderer* r)
 {
     glDeleteTextures(1, &r->ev);
-    r->ev = 0;
+    glDeleteTextures(1, &r->occ);
+    r->ev = r->occ = 0;
     r->ev_key = 0;
     r->has_volume = 0;
     drop_opvs(r);
@@ -83,6 +87,7 @@ void veil_renderer_destroy(veil_renderer* r)
     drop_volume(r);
     glDeleteProgram(r->inject);
     glDeleteProgram(r->march);
+    glDeleteProgram(r->occupancy);
     veil_opv_programs_destroy(&r->opv_programs);
     free(r);
 }
@@ -167,6 +172,29 @@ static veil_result make_ev(veil_renderer* r, const veil_grid* g, uint64_t key, i
     r->has_volume = 1;
     r->ev_key = key;
     return VEIL_OK;
+}
+
+/* The EV's occupancy bricks (render/shaders/occupancy.comp), made once
+ * the EV holds its density. */
+static veil_result build_occupancy(veil_renderer* r, veil_error* err)
+{
+    int b[3];
+    for (int a = 0; a < 3; ++a) b[a] = (r->grid.dims[a] + VEIL_BRICK - 1) / VEIL_BRICK;
+    veil_result res = veil_gl_texture3d(GL_R32F, b, "veil occupancy bricks", &r->occ, err);
+    if (res != VEIL_OK) return res;
+    GLuint p = r->occupancy;
+    glUseProgram(p);
+    glProgramUniform3i(p, glGetUniformLocation(p, "u_dims"), r->grid.dims[0], r->grid.dims[1], r->grid.dims[2]);
+    glProgramUniform3i(p, glGetUniformLocation(p, "u_bricks"), b[0], b[1], b[2]);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glBindImageTexture(VEIL_IMAGE_EV, r->ev, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32F);
+    glBindImageTexture(VEIL_IMAGE_OUT, r->occ, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+    glDispatchCompute(veil_groups(b[0], 4), veil_groups(b[1], 4), veil_groups(b[2], 4));
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glBindImageTexture(VEIL_IMAGE_EV, 0, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32F);
+    glBindImageTexture(VEIL_IMAGE_OUT, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+    glUseProgram(0);
+    return veil_gl_check("occupancy bricks (render/shaders/occupancy.comp)", err);
 }
 
 /* The scene's OpenVDB grids, opened; count of them in *n. */
@@ -264,6 +292,7 @@ static veil_result inject_scene(veil_renderer* r, const veil_scene* s, veil_rend
             }
             if (res == VEIL_OK && n > 0) res = veil_rbf_bin(&g, parts, n, &bins, err);
             if (res == VEIL_OK && n > 0) res = veil_inject_rbf_gpu(r->inject, &g, &bins, r->ev, err);
+            if (res == VEIL_OK) res = build_occupancy(r, err);
             if (res != VEIL_OK) drop_volume(r);
         }
         free(density);
@@ -312,7 +341,7 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
 
 static void set_march_uniforms(GLuint p, const veil_scene* s, const veil_light* lights, int n,
                                const veil_camera_basis* cam, int w, int h, const veil_grid* g, float step_voxels,
-                               uint32_t seed)
+                               uint32_t seed, int skip_empty)
 {
     glProgramUniform2i(p, glGetUniformLocation(p, "u_size"), w, h);
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_cam_pos"), 1, cam->pos);
@@ -377,6 +406,8 @@ static void set_march_uniforms(GLuint p, const veil_scene* s, const veil_light* 
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_fog_origin"), VEIL_MAX_FOGS, fo);
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_fog_min"), VEIL_MAX_FOGS, flo);
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_fog_max"), VEIL_MAX_FOGS, fhi);
+    glProgramUniform1i(p, glGetUniformLocation(p, "u_skip"), g != NULL && fogs == 0 && skip_empty);
+    if (g) glProgramUniform1f(p, glGetUniformLocation(p, "u_voxel"), g->voxel);
     if (!g) {
         float md = VEIL_MIN_LIGHT_DISTANCE_VOXELS * VEIL_FOG_MIN_STEP;
         glProgramUniform1f(p, glGetUniformLocation(p, "u_step"), VEIL_FOG_MIN_STEP);
@@ -408,14 +439,16 @@ static veil_result march(veil_renderer* r, const veil_scene* s, const veil_light
     if (res == VEIL_OK) {
         GLuint p = r->march;
         glUseProgram(p);
-        set_march_uniforms(p, s, lights, n, &cam, w, h, r->has_volume ? &r->grid : NULL, step, o->seed);
+        set_march_uniforms(p, s, lights, n, &cam, w, h, r->has_volume ? &r->grid : NULL, step, o->seed,
+                           !o->no_skip);
         glBindTextureUnit(VEIL_TEX_EV, r->ev);
+        glBindTextureUnit(VEIL_TEX_OCC, r->occ);
         for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, r->opv[t]);
         glBindImageTexture(VEIL_IMAGE_OUT, out_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glDispatchCompute(veil_groups(w, VEIL_MARCH_GROUP), veil_groups(h, VEIL_MARCH_GROUP), 1);
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
         glBindImageTexture(VEIL_IMAGE_OUT, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        for (int t = 0; t <= VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit((GLuint)t, 0);
+        for (int t = 0; t <= VEIL_TEX_OCC; ++t) glBindTextureUnit((GLuint)t, 0);
         glUseProgram(0);
         res = veil_gl_check("ray march (render/shaders/march.comp)", err);
         if (res == VEIL_OK) res = read_texture(out_tex, GL_RGBA, floats, *rgba, "reading back the image", err);
@@ -483,6 +516,7 @@ veil_result veil_render_density(veil_renderer* r, const veil_scene* s, const vei
             glTextureSubImage3D(r->ev, 0, 0, 0, 0, g->dims[0], g->dims[1], g->dims[2], GL_RED, GL_FLOAT, density);
             res = veil_gl_check("uploading the extinction volume", err);
         }
+        if (res == VEIL_OK) res = build_occupancy(r, err);
         if (res != VEIL_OK) drop_volume(r);
         r->particles = 0;
     }

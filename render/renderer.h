@@ -54,6 +54,7 @@ typedef struct veil_render_opts {
     uint32_t seed;          /* jitter seed */
     veil_opv_method method; /* 0: VEIL_OPV_DEFAULT_METHOD */
     const veil_camera* camera; /* NULL: the scene's (turntables move it) */
+    int no_skip;            /* 1: march through empty bricks too (to measure what skipping saves) */
 } veil_render_opts;
 
 typedef struct veil_render_stats {

@@ -17,12 +17,18 @@
 // spot: times its cone falloff) or E (directional), times the phase
 // function. D_ev is read from the optical-depth volume at X, or, outside the
 // EV's box, where the path to the light enters the box; D_fog is closed form.
+// Empty space: where a brick of the EV and the voxel ring around it hold no
+// density (render/shaders/occupancy.comp) every sample in it would add
+// nothing, so without fog the march jumps to where the ray leaves the brick.
 // Output: rgb = L + T * background, a = 1 - mean(T).
 layout(local_size_x = VEIL_MARCH_GROUP, local_size_y = VEIL_MARCH_GROUP) in;
 
 layout(binding = VEIL_IMAGE_OUT, rgba32f) writeonly uniform image2D u_out;
 layout(binding = VEIL_TEX_EV) uniform sampler3D u_ev;
 uniform sampler3D u_opv[VEIL_MAX_OPV_TEXTURES];
+layout(binding = VEIL_TEX_OCC) uniform sampler3D u_occ; // max density per VEIL_BRICK^3 brick (ring included)
+uniform int u_skip;       // 1: skip bricks of zero density (no fog to sample there)
+uniform float u_voxel;    // m
 
 uniform ivec2 u_size;
 uniform vec3 u_cam_pos, u_cam_fwd, u_cam_right, u_cam_up; // right/up scaled by tan(fov/2) (and aspect)
@@ -156,6 +162,16 @@ void main()
     while (t < t_end) {
         vec3 x0 = u_cam_pos + dir * t;
         bool in_ev = u_has_volume != 0 && t >= ev.x && t < ev.y;
+        if (in_ev && u_skip != 0) {
+            ivec3 b = ivec3(floor(((x0 - u_tex_min) / u_voxel - 0.5) / float(VEIL_BRICK)));
+            b = clamp(b, ivec3(0), textureSize(u_occ, 0) - 1);
+            if (texelFetch(u_occ, b, 0).r <= 0.0) {
+                vec3 lo = u_tex_min + (vec3(b * VEIL_BRICK) + 0.5) * u_voxel;
+                float exit_t = box_hit(u_cam_pos, dir, lo, lo + float(VEIL_BRICK) * u_voxel, t, INF).y;
+                t = max(exit_t, t + 1e-4 * u_step);
+                continue;
+            }
+        }
         float step = in_ev ? u_step
                            : max(u_step, min(VEIL_FOG_STEP_FRACTION * max(t, u_step), 0.25 * nearest_light(x0)));
         if (first) step *= jitter;
