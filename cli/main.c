@@ -4,6 +4,9 @@
  *               [--step S] [--seed N] [--method M] [--turntable N] [--stats]
  *   veil gpuinfo
  *   veil info FILE.vdb [--json]
+ *   veil rbf generate -o OUT --count N --seed S --bounds x0,y0,z0,x1,y1,z1
+ *               --radius r0,r1 --amplitude c0,c1 [--noise-scale L]
+ *               [--noise-octaves K] [--noise-amount A] [--format json|binary]
  *   veil --help | --version
  *
  * Exit codes: 0 success, 1 bad input (scene, file), 2 usage, 3 GPU/driver.
@@ -20,6 +23,7 @@
 #include <unistd.h>
 
 #include "io/image.h"
+#include "io/particles.h"
 #include "io/scene.h"
 #include "io/vdb.h"
 #include "render/gl_context.h"
@@ -33,6 +37,9 @@ static const char* usage_text =
     "                   [--step S] [--seed N] [--method M] [--turntable N] [--stats]\n"
     "       veil gpuinfo\n"
     "       veil info FILE.vdb [--json]\n"
+    "       veil rbf generate -o OUT --count N --seed S --bounds x0,y0,z0,x1,y1,z1\n"
+    "                --radius r0,r1 --amplitude c0,c1 [--noise-scale L] [--noise-octaves K]\n"
+    "                [--noise-amount A] [--format json|binary]\n"
     "       veil --help | --version\n"
     "\n"
     "render   renders a scene (docs/scene-format.md) to an HDR EXR (R, G, B, A = 1 - mean\n"
@@ -53,6 +60,14 @@ static const char* usage_text =
     "info     lists the grids of an OpenVDB file: name, class, value type, active\n"
     "         voxels, index and world bounding boxes, voxel size and transform.\n"
     "  --json         print them as JSON instead of a table\n"
+    "rbf generate  writes a seeded random particle file (docs/particles.md) for an\n"
+    "         \"rbf\" source's \"file\": N particles (0..10000000), centres uniform in\n"
+    "         the box, radius (1/sharpness, m) and amplitude uniform in their ranges;\n"
+    "         the same seed (0..2^53-1) gives the same file on every machine.\n"
+    "  --noise-amount A  0..1 (default 0): amplitude *= (1-A) + A*fbm(centre/L)\n"
+    "  --noise-scale L   fBm feature size in metres (default 1)\n"
+    "  --noise-octaves K fBm octaves, 1..16 (default 4)\n"
+    "  --format F     json or binary (default: json when OUT ends in .json)\n"
     "\n"
     "exit codes: 0 success, 1 bad input, 2 usage, 3 GPU or driver failure\n";
 
@@ -356,6 +371,99 @@ static int cmd_render(int argc, char** argv)
     return r == VEIL_OK ? EXIT_OK : fail(r, &err);
 }
 
+/* veil rbf generate: a seeded random particle file, optionally fBm-modulated. */
+static int cmd_rbf(int argc, char** argv)
+{
+    if (argc < 3 || strcmp(argv[2], "generate") != 0)
+        return usage_error("rbf: expected the subcommand 'generate', got '%s'", argc < 3 ? "" : argv[2]);
+    const char* out = NULL;
+    long count = -1, seed = -1, octaves = 4, format = -1; /* format: -1 by extension, 0 json, 1 binary */
+    float v6[6] = {0}, bounds[6] = {0}, radius[2] = {0}, amp[2] = {0}, scale = 1.0f, amount = 0.0f;
+    int have_b = 0, have_r = 0, have_a = 0;
+    for (int i = 3; i < argc; ++i) {
+        const char* s = argv[i];
+        const char* v = i + 1 < argc ? argv[i + 1] : NULL;
+        int nlist = !strcmp(s, "--bounds") ? 6 : (!strcmp(s, "--radius") || !strcmp(s, "--amplitude")) ? 2 : 0;
+        int takes = nlist || !strcmp(s, "-o") || !strcmp(s, "--count") || !strcmp(s, "--seed") ||
+                    !strcmp(s, "--noise-scale") || !strcmp(s, "--noise-octaves") || !strcmp(s, "--noise-amount") ||
+                    !strcmp(s, "--format");
+        if (!takes) {
+            if (s[0] == '-' && s[1]) return usage_error("unknown option '%s'", s);
+            return usage_error("unexpected argument '%s'", s);
+        }
+        if (!v) return usage_error("%s needs a value", s);
+        ++i;
+        if (nlist) { /* comma-separated finite numbers */
+            const char* p = v;
+            int k = 0;
+            for (; k < nlist; ++k) {
+                char* end;
+                errno = 0;
+                v6[k] = strtof(p, &end);
+                if (errno || end == p || !isfinite(v6[k])) break;
+                if (k + 1 < nlist && *end != ',') break;
+                if (k + 1 == nlist && *end) break;
+                p = end + 1;
+            }
+            int ok = k == nlist;
+            if (ok && nlist == 6) {
+                for (int a = 0; a < 3; ++a) ok = ok && v6[a] <= v6[a + 3];
+                if (!ok)
+                    return usage_error("--bounds: expected x0,y0,z0,x1,y1,z1 (min and max corner, m) with min <= max, got '%s'", v);
+                memcpy(bounds, v6, sizeof bounds), have_b = 1;
+            } else if (ok && !strcmp(s, "--radius")) {
+                if (!(v6[0] > 0 && v6[0] <= v6[1] && isfinite(1.0f / v6[0])))
+                    return usage_error("--radius: expected r0,r1 with 0 < r0 <= r1 (m), got '%s'", v);
+                memcpy(radius, v6, sizeof radius), have_r = 1;
+            } else if (ok) {
+                if (!(v6[0] >= 0 && v6[0] <= v6[1]))
+                    return usage_error("--amplitude: expected c0,c1 with 0 <= c0 <= c1, got '%s'", v);
+                memcpy(amp, v6, sizeof amp), have_a = 1;
+            } else if (nlist == 6) {
+                return usage_error("--bounds: expected 6 comma-separated numbers x0,y0,z0,x1,y1,z1, got '%s'", v);
+            } else {
+                return usage_error(!strcmp(s, "--radius") ? "--radius: expected 2 comma-separated numbers r0,r1, got '%s'"
+                                                          : "--amplitude: expected 2 comma-separated numbers c0,c1, got '%s'", v);
+            }
+        } else if (!strcmp(s, "-o")) out = v;
+        else if (!strcmp(s, "--count")) {
+            if (!parse_int(v, 0, VEIL_SCENE_MAX_PARTICLES, &count)) return usage_error("--count: expected an integer in 0..10000000, got '%s'", v);
+        } else if (!strcmp(s, "--seed")) {
+            if (!parse_int(v, 0, 9007199254740991L, &seed)) return usage_error("--seed: expected an integer in 0..2^53-1, got '%s'", v);
+        } else if (!strcmp(s, "--noise-octaves")) {
+            if (!parse_int(v, 1, 16, &octaves)) return usage_error("--noise-octaves: expected an integer in 1..16, got '%s'", v);
+        } else if (!strcmp(s, "--noise-amount")) {
+            if (!parse_float(v, 0.0f, 1.0f, &amount)) return usage_error("--noise-amount: expected a number in 0..1, got '%s'", v);
+        } else if (!strcmp(s, "--noise-scale")) {
+            if (!parse_float(v, 1e-30f, 3.4e38f, &scale)) return usage_error("--noise-scale: expected a length > 0 (m), got '%s'", v);
+        } else if (!strcmp(v, "json") || !strcmp(v, "binary")) format = !strcmp(v, "binary");
+        else return usage_error("--format: expected json or binary, got '%s'", v);
+    }
+    if (!out) return usage_error("%s", "rbf generate: missing -o OUT");
+    if (count < 0) return usage_error("%s", "rbf generate: missing --count N");
+    if (seed < 0) return usage_error("%s", "rbf generate: missing --seed S");
+    if (!have_b) return usage_error("%s", "rbf generate: missing --bounds x0,y0,z0,x1,y1,z1");
+    if (!have_r) return usage_error("%s", "rbf generate: missing --radius r0,r1");
+    if (!have_a) return usage_error("%s", "rbf generate: missing --amplitude c0,c1");
+    if (format < 0) {
+        size_t n = strlen(out);
+        format = !(n >= 5 && !strcmp(out + n - 5, ".json"));
+    }
+    veil_rbf_random_desc d = {.count = (uint32_t)count, .seed = (uint64_t)seed,
+                              .bounds = {{bounds[0], bounds[1], bounds[2]}, {bounds[3], bounds[4], bounds[5]}},
+                              .radius = {radius[0], radius[1]}, .amplitude = {amp[0], amp[1]}};
+    veil_particle* p = count ? malloc((size_t)count * sizeof *p) : NULL;
+    veil_error err = {0};
+    if (count && !p) return fail(veil_fail(&err, VEIL_ERR_OOM, "out of memory for %ld particles", count), &err);
+    veil_rbf_random_generate(&d, p);
+    veil_particles_modulate(p, (size_t)count, (uint64_t)seed, scale, (int)octaves, amount);
+    veil_result r = veil_particles_write(out, p, (size_t)count, (int)format, &err);
+    free(p);
+    if (r != VEIL_OK) return fail(r, &err);
+    printf("wrote %s (%ld particles, %s)\n", out, count, format ? "binary" : "json");
+    return EXIT_OK;
+}
+
 int main(int argc, char** argv)
 {
     if (argc < 2) {
@@ -373,6 +481,7 @@ int main(int argc, char** argv)
     }
     if (!strcmp(cmd, "render")) return cmd_render(argc, argv);
     if (!strcmp(cmd, "info")) return cmd_info(argc, argv);
+    if (!strcmp(cmd, "rbf")) return cmd_rbf(argc, argv);
     if (!strcmp(cmd, "gpuinfo")) {
         if (argc > 2) return usage_error("gpuinfo takes no arguments, got '%s'", argv[2]);
         return cmd_gpuinfo();

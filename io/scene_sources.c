@@ -2,6 +2,7 @@
  * docs/scene-format.md): explicit RBF particles, seeded random particle
  * clouds, OpenVDB grids and analytic exponential fog. Private to io/. */
 #include "scene_sources.h"
+#include "particles.h"
 
 #include <errno.h>
 #include <math.h>
@@ -12,7 +13,7 @@
 static const char* const SOURCE_TYPES[] = {"rbf", "rbf_random", "vdb", "exponential", NULL}; /* = veil_source_type */
 static const char* const VDB_KEYS[] = {"type", "file", "grid", "density_scale", "level_set", NULL};
 static const char* const FOG_KEYS[] = {"type", "density", "falloff", "direction", "origin", "bounds", NULL};
-static const char* const RBF_KEYS[] = {"type", "particles", NULL};
+static const char* const RBF_KEYS[] = {"type", "particles", "file", NULL};
 static const char* const RANDOM_KEYS[] = {"type", "count", "seed", "bounds", "radius", "amplitude", NULL};
 static const char* const PARTICLE_KEYS[] = {"center", "amplitude", "sharpness", NULL};
 
@@ -110,6 +111,36 @@ static veil_result resolve_file(const ctx* c, const jpath* fp, char** file)
     return VEIL_OK;
 }
 
+/* "rbf": inline "particles", or a particle "file" (docs/particles.md) read now. */
+static veil_result parse_rbf(const ctx* c, const cJSON* so, const jpath* sp, veil_source* src)
+{
+    const jpath fp = {sp, "file", 0};
+    const bool inl = cJSON_GetObjectItemCaseSensitive(so, "particles") != NULL;
+    const bool file = cJSON_GetObjectItemCaseSensitive(so, "file") != NULL;
+    if (inl && file)
+        return veil__jr_fail_at(c, sp, "give either \"particles\" or \"file\", not both");
+    if (!file) {
+        if (!inl)
+            return veil__jr_fail_at(c, sp, "missing required field: \"particles\" (an array of particles) or "
+                                           "\"file\" (a particle file, docs/particles.md)");
+        return parse_particles(c, so, sp, src);
+    }
+    char* path = NULL;
+    veil_result r = get_string(c, so, sp, "file", true, &path);
+    if (r == VEIL_OK) r = resolve_file(c, &fp, &path);
+    if (r == VEIL_OK) {
+        veil_error inner = {0};
+        r = veil_particles_read(path, &src->particles, &src->particle_count, &inner);
+        if (r != VEIL_OK) {
+            veil_result code = r;
+            r = veil__jr_fail_at(c, &fp, "%s", inner.msg);
+            if (code == VEIL_ERR_OOM || code == VEIL_ERR_LIMIT || code == VEIL_ERR_IO) r = code; /* same message */
+        }
+    }
+    free(path);
+    return r;
+}
+
 static veil_result parse_vdb(const ctx* c, const cJSON* so, const jpath* sp, veil_vdb_source* v)
 {
     const jpath fp = {sp, "file", 0}, lp = {sp, "level_set", 0};
@@ -175,7 +206,7 @@ veil_result veil__parse_sources(const ctx* c, const cJSON* medium, const jpath* 
         src->type = (veil_source_type)kind;
         TRY(veil__jr_check_keys(c, e, &ep, keys[kind]));
         switch (src->type) {
-        case VEIL_SOURCE_RBF: TRY(parse_particles(c, e, &ep, src)); break;
+        case VEIL_SOURCE_RBF: TRY(parse_rbf(c, e, &ep, src)); break;
         case VEIL_SOURCE_RBF_RANDOM: TRY(parse_random(c, e, &ep, &src->random)); break;
         case VEIL_SOURCE_VDB: TRY(parse_vdb(c, e, &ep, &src->vdb)); break;
         case VEIL_SOURCE_EXPONENTIAL:

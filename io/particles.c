@@ -1,0 +1,409 @@
+/* veil — RBF particle files: JSON and the compact little-endian binary
+ * format (docs/particles.md), and the fBm modulation of `veil rbf generate`. */
+#define _POSIX_C_SOURCE 200809L
+#include "particles.h"
+
+#include <errno.h>
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "json_read.h"
+#include "scene.h"
+#include "tempfile.h"
+
+/* Particle files larger than this are refused before reading (the binary
+ * format needs 200 MB for the particle limit; JSON ~110 bytes a particle). */
+#define PARTICLES_MAX_FILE_BYTES ((size_t)2 << 30)
+
+static const char* const FILE_KEYS[] = {"format", "version", "particles", NULL};
+static const char* const PARTICLE_KEYS[] = {"center", "amplitude", "sharpness", NULL};
+static const char* const FIELD_NAMES[5] = {"center[0]", "center[1]", "center[2]", "amplitude", "sharpness"};
+
+/* ---- checks shared by reader and writer -------------------------------- */
+
+/* Index of the first bad field of q (0..4), or -1; *why says what was expected. */
+static int bad_field(const veil_particle* q, const char** why)
+{
+    for (int k = 0; k < 3; ++k)
+        if (!isfinite(q->center[k])) return *why = "a finite number", k;
+    if (!(isfinite(q->amplitude) && q->amplitude >= 0.0f)) return *why = "a finite number >= 0", 3;
+    if (!(isfinite(q->sharpness) && q->sharpness > 0.0f)) return *why = "a finite number > 0", 4;
+    return -1;
+}
+
+static float field(const veil_particle* q, int k) { return k < 3 ? q->center[k] : k == 3 ? q->amplitude : q->sharpness; }
+
+/* ---- little-endian bytes ----------------------------------------------- */
+
+static uint32_t get_u32(const unsigned char* b)
+{
+    return (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+}
+
+static void put_u32(unsigned char* b, uint32_t v)
+{
+    b[0] = (unsigned char)v, b[1] = (unsigned char)(v >> 8), b[2] = (unsigned char)(v >> 16),
+    b[3] = (unsigned char)(v >> 24);
+}
+
+static float get_f32(const unsigned char* b)
+{
+    uint32_t u = get_u32(b);
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+static void put_f32(unsigned char* b, float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    put_u32(b, u);
+}
+
+/* ---- reading ----------------------------------------------------------- */
+
+static veil_result read_whole(const char* path, unsigned char** buf, size_t* len, veil_error* err)
+{
+    errno = 0;
+    FILE* f = fopen(path, "rb");
+    if (!f) return veil_fail(err, VEIL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    size_t cap = (size_t)1 << 16, n = 0;
+    unsigned char* b = NULL;
+    veil_result r = VEIL_OK;
+    for (;;) {
+        unsigned char* nb = realloc(b, cap + 1);
+        if (!nb) {
+            r = veil_fail(err, VEIL_ERR_OOM, "%s: out of memory reading %zu bytes", path, cap);
+            break;
+        }
+        b = nb;
+        n += fread(b + n, 1, cap - n, f);
+        if (n < cap) break; /* end of file or error */
+        if (n > PARTICLES_MAX_FILE_BYTES) {
+            r = veil_fail(err, VEIL_ERR_LIMIT, "%s: file is larger than %zu MiB, the limit for particle files",
+                          path, PARTICLES_MAX_FILE_BYTES >> 20);
+            break;
+        }
+        cap = cap > PARTICLES_MAX_FILE_BYTES / 2 ? PARTICLES_MAX_FILE_BYTES + 1 : 2 * cap;
+    }
+    if (r == VEIL_OK && ferror(f)) r = veil_fail(err, VEIL_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
+    fclose(f);
+    if (r != VEIL_OK) {
+        free(b);
+        return r;
+    }
+    b[n] = '\0';
+    *buf = b, *len = n;
+    return VEIL_OK;
+}
+
+static veil_result read_binary(const char* path, const unsigned char* b, size_t len, veil_particle** out,
+                               size_t* count, veil_error* err)
+{
+    if (len < VEIL_PARTICLES_HEADER_BYTES)
+        return veil_fail(err, VEIL_ERR_INVALID, "%s: truncated header: %zu bytes, a binary particle file has at least %u",
+                         path, len, VEIL_PARTICLES_HEADER_BYTES);
+    uint32_t n = get_u32(b + 8), reserved = get_u32(b + 12);
+    if (reserved != 0)
+        return veil_fail(err, VEIL_ERR_INVALID, "%s: header: reserved field is %u, expected 0", path, reserved);
+    if (n > VEIL_SCENE_MAX_PARTICLES)
+        return veil_fail(err, VEIL_ERR_LIMIT, "%s: header: %u particles, at most %u are supported", path, n,
+                         VEIL_SCENE_MAX_PARTICLES);
+    size_t want = VEIL_PARTICLES_HEADER_BYTES + (size_t)n * VEIL_PARTICLES_RECORD_BYTES;
+    if (len < want)
+        return veil_fail(err, VEIL_ERR_INVALID,
+                         "%s: truncated: the header announces %u particles (%zu bytes), the file has %zu bytes",
+                         path, n, want, len);
+    if (len > want)
+        return veil_fail(err, VEIL_ERR_INVALID,
+                         "%s: %zu bytes of trailing data after the %u particles the header announces "
+                         "(expected exactly %zu bytes)", path, len - want, n, want);
+    veil_particle* p = NULL;
+    if (n) {
+        p = malloc((size_t)n * sizeof *p);
+        if (!p) return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory for %u particles", path, n);
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+        const unsigned char* r = b + VEIL_PARTICLES_HEADER_BYTES + (size_t)i * VEIL_PARTICLES_RECORD_BYTES;
+        veil_particle* q = &p[i];
+        for (int k = 0; k < 3; ++k) q->center[k] = get_f32(r + 4 * k);
+        q->amplitude = get_f32(r + 12);
+        q->sharpness = get_f32(r + 16);
+        const char* why;
+        int k = bad_field(q, &why);
+        if (k >= 0) {
+            veil_result res = veil_fail(err, VEIL_ERR_INVALID, "%s: particle %u: %s: expected %s, got %g", path, i,
+                                        FIELD_NAMES[k], why, (double)field(q, k));
+            free(p);
+            return res;
+        }
+    }
+    *out = p, *count = n;
+    return VEIL_OK;
+}
+
+static veil_result json_syntax(const char* path, const char* s, size_t len, size_t pos, veil_error* err)
+{
+    size_t line = 1, col = 1;
+    for (size_t i = 0; i < pos && i < len; ++i) {
+        if (s[i] == '\n') line++, col = 1;
+        else if (((unsigned char)s[i] & 0xC0) != 0x80) col++;
+    }
+    return veil_fail(err, VEIL_ERR_PARSE, "%s:%zu:%zu: JSON syntax error", path, line, col);
+}
+
+static veil_result parse_json_particles(const ctx* c, const cJSON* root, veil_particle** out, size_t* count)
+{
+    const jpath fp = {NULL, "format", 0}, vp = {NULL, "version", 0}, pp = {NULL, "particles", 0};
+    const cJSON* v;
+    if (!cJSON_IsObject(root)) return veil__jr_fail_at(c, NULL, "expected a JSON object at the top level");
+    TRY(veil__jr_check_keys(c, root, NULL, FILE_KEYS));
+    TRY(veil__jr_lookup(c, root, &fp, true, "the string \"veil-particles\"", &v));
+    if (!cJSON_IsString(v) || strcmp(v->valuestring, "veil-particles") != 0)
+        return veil__jr_expected(c, &fp, "the string \"veil-particles\"", v);
+    TRY(veil__jr_lookup(c, root, &vp, true, "the number 1", &v));
+    if (!cJSON_IsNumber(v) || v->valuedouble != 1.0) return veil__jr_expected(c, &vp, "the number 1", v);
+    const cJSON* arr, *e;
+    TRY(veil__jr_get_container(c, root, &pp, true, true, &arr));
+    void* items = NULL;
+    TRY(veil__jr_alloc_items(c, &pp, arr, sizeof **out, VEIL_SCENE_MAX_PARTICLES, &items, count));
+    *out = items;
+    size_t i = 0;
+    cJSON_ArrayForEach(e, arr) {
+        const jpath ep = {&pp, NULL, i};
+        veil_particle* q = &(*out)[i++];
+        double amp, sharp;
+        if (!cJSON_IsObject(e)) return veil__jr_expected(c, &ep, "an object", e);
+        TRY(veil__jr_check_keys(c, e, &ep, PARTICLE_KEYS));
+        TRY(veil__jr_get_floats(c, e, &ep, "center", true, 3, false, q->center));
+        TRY(veil__jr_get_number(c, e, &ep, "amplitude", true, &VEIL__R_NONNEG, &amp));
+        TRY(veil__jr_get_number(c, e, &ep, "sharpness", true, &VEIL__R_POS, &sharp));
+        q->amplitude = (float)amp, q->sharpness = (float)sharp;
+        const char* why;
+        int k = bad_field(q, &why);
+        if (k >= 0) {
+            const jpath kp = {&ep, k < 3 ? "center" : FIELD_NAMES[k], 0};
+            return veil__jr_fail_at(c, &kp, "expected %s that fits a 32-bit float, got %g", why,
+                                    k == 3 ? amp : k == 4 ? sharp : (double)q->center[k]);
+        }
+        if (q->sharpness == 0.0f) /* a tiny positive double that rounds to 0 */
+            return veil__jr_fail_at(c, &ep, "sharpness %g rounds to 0 as a 32-bit float", sharp);
+    }
+    return VEIL_OK;
+}
+
+static veil_result read_json(const char* path, const char* s, size_t len, veil_particle** out, size_t* count,
+                             veil_error* err)
+{
+    const char* end = NULL;
+    cJSON* root = cJSON_ParseWithLengthOpts(s, len, &end, 0);
+    size_t pos = end && end >= s && end <= s + len ? (size_t)(end - s) : 0;
+    if (!root) return json_syntax(path, s, len, pos, err);
+    while (pos < len && strchr(" \t\r\n", s[pos]) && s[pos]) ++pos;
+    if (pos < len) {
+        cJSON_Delete(root);
+        return json_syntax(path, s, len, pos, err);
+    }
+    const ctx c = {path, err};
+    veil_particle* p = NULL;
+    size_t n = 0;
+    veil_result r = parse_json_particles(&c, root, &p, &n);
+    cJSON_Delete(root);
+    if (r != VEIL_OK) {
+        free(p);
+        return r;
+    }
+    if (n == 0) free(p), p = NULL;
+    *out = p, *count = n;
+    return VEIL_OK;
+}
+
+veil_result veil_particles_read(const char* path, veil_particle** out, size_t* count, veil_error* err)
+{
+    if (!path || !out || !count) return veil_fail(err, VEIL_ERR_INVALID, "veil_particles_read: NULL argument");
+    *out = NULL, *count = 0;
+    unsigned char* b = NULL;
+    size_t len = 0;
+    TRY(read_whole(path, &b, &len, err));
+    veil_result r;
+    size_t first = 0;
+    while (first < len && strchr(" \t\r\n", b[first]) && b[first]) ++first;
+    if (len >= 8 && memcmp(b, VEIL_PARTICLES_MAGIC, 8) == 0)
+        r = read_binary(path, b, len, out, count, err);
+    else if (first < len && b[first] == '{')
+        r = read_json(path, (const char*)b, len, out, count, err);
+    else if (len == 0)
+        r = veil_fail(err, VEIL_ERR_INVALID, "%s: empty file, not a particle file", path);
+    else
+        r = veil_fail(err, VEIL_ERR_INVALID,
+                      "%s: not a particle file (expected the magic \"" VEIL_PARTICLES_MAGIC
+                      "\" or a JSON object, see docs/particles.md)", path);
+    free(b);
+    return r;
+}
+
+/* ---- writing ----------------------------------------------------------- */
+
+static veil_result encode_binary(const veil_particle* p, size_t n, char** buf, size_t* len)
+{
+    size_t total = VEIL_PARTICLES_HEADER_BYTES + n * VEIL_PARTICLES_RECORD_BYTES;
+    unsigned char* b = malloc(total);
+    if (!b) return VEIL_ERR_OOM;
+    memcpy(b, VEIL_PARTICLES_MAGIC, 8);
+    put_u32(b + 8, (uint32_t)n);
+    put_u32(b + 12, 0);
+    for (size_t i = 0; i < n; ++i) {
+        unsigned char* r = b + VEIL_PARTICLES_HEADER_BYTES + i * VEIL_PARTICLES_RECORD_BYTES;
+        for (int k = 0; k < 5; ++k) put_f32(r + 4 * k, field(&p[i], k));
+    }
+    *buf = (char*)b, *len = total;
+    return VEIL_OK;
+}
+
+/* 9 significant digits identify a float; where the shortest such decimal
+ * lies beyond FLT_MAX (readers refuse it) or does not read back as f, all
+ * 17 digits of the double are written: the round trip is bit-exact. */
+static void fmt_float(char* out, size_t n, float f)
+{
+    snprintf(out, n, "%.9g", (double)f);
+    double d = strtod(out, NULL);
+    if (!(fabs(d) <= FLT_MAX) || (float)d != f) snprintf(out, n, "%.17g", (double)f);
+}
+
+static veil_result encode_json(const veil_particle* p, size_t n, char** buf, size_t* len)
+{
+    static const char head[] = "{\"format\": \"veil-particles\", \"version\": 1, \"particles\": [";
+    enum { PER = 160 };
+    size_t cap = sizeof head + 8 + n * PER;
+    char* b = malloc(cap);
+    if (!b) return VEIL_ERR_OOM;
+    size_t k = (size_t)snprintf(b, cap, "%s", head);
+    for (size_t i = 0; i < n; ++i) {
+        char v[5][32];
+        for (int f = 0; f < 5; ++f) fmt_float(v[f], sizeof v[f], field(&p[i], f));
+        k += (size_t)snprintf(b + k, cap - k, "%s\n  {\"center\": [%s, %s, %s], \"amplitude\": %s, \"sharpness\": %s}",
+                              i ? "," : "", v[0], v[1], v[2], v[3], v[4]);
+    }
+    k += (size_t)snprintf(b + k, cap - k, "%s]}\n", n ? "\n" : "");
+    *buf = b, *len = k;
+    return VEIL_OK;
+}
+
+veil_result veil_particles_write(const char* path, const veil_particle* p, size_t n, int binary, veil_error* err)
+{
+    if (!path || (!p && n)) return veil_fail(err, VEIL_ERR_INVALID, "veil_particles_write: NULL argument");
+    if (n > VEIL_SCENE_MAX_PARTICLES)
+        return veil_fail(err, VEIL_ERR_LIMIT, "%s: %zu particles, at most %u are supported", path, n,
+                         VEIL_SCENE_MAX_PARTICLES);
+    for (size_t i = 0; i < n; ++i) {
+        const char* why;
+        int k = bad_field(&p[i], &why);
+        if (k >= 0)
+            return veil_fail(err, VEIL_ERR_INVALID, "%s: particle %zu: %s: expected %s, got %g", path, i,
+                             FIELD_NAMES[k], why, (double)field(&p[i], k));
+    }
+    char* buf = NULL;
+    size_t len = 0;
+    if ((binary ? encode_binary(p, n, &buf, &len) : encode_json(p, n, &buf, &len)) != VEIL_OK)
+        return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory encoding %zu particles", path, n);
+    char* tmp = NULL;
+    int fd = veil_open_temp_beside(path, &tmp);
+    if (fd < 0) {
+        veil_result r = errno ? veil_fail(err, VEIL_ERR_IO, "%s: cannot create: %s", path, strerror(errno))
+                              : veil_fail(err, VEIL_ERR_IO, "%s: exists and is not a regular file", path);
+        free(buf);
+        return r;
+    }
+    size_t done = 0;
+    int e = 0;
+    while (done < len) {
+        ssize_t w = write(fd, buf + done, len - done);
+        if (w < 0) {
+            if (errno == EINTR) continue;
+            e = errno;
+            break;
+        }
+        done += (size_t)w;
+    }
+    free(buf);
+    if (close(fd) != 0 && !e) e = errno;
+    if (!e && rename(tmp, path) != 0) e = errno;
+    if (e) {
+        unlink(tmp);
+        free(tmp);
+        return veil_fail(err, VEIL_ERR_IO, "%s: cannot write: %s", path, strerror(e));
+    }
+    free(tmp);
+    return VEIL_OK;
+}
+
+/* ---- fBm value noise --------------------------------------------------- */
+
+/* A 64-bit integer hash of a lattice point (SplitMix64's finaliser). */
+static uint64_t mix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+/* Lattice value in [0, 1), 24 bits: exact as a float. */
+static float lattice(uint64_t key, int64_t x, int64_t y, int64_t z)
+{
+    uint64_t h = mix64(key ^ (uint64_t)x);
+    h = mix64(h ^ (uint64_t)y);
+    h = mix64(h ^ (uint64_t)z);
+    return (float)(h >> 40) * (1.0f / 16777216.0f);
+}
+
+static float lerpf(float a, float b, float t) { return a + (b - a) * t; }
+
+/* Trilinear value noise with a smoothstep fade, in [0, 1). */
+static float value_noise(uint64_t key, const float x[3])
+{
+    int64_t i[3];
+    float t[3];
+    for (int a = 0; a < 3; ++a) {
+        float v = x[a];
+        if (!(v > -1e15f)) v = -1e15f; /* also NaN */
+        if (v > 1e15f) v = 1e15f;
+        float fl = floorf(v);
+        i[a] = (int64_t)fl;
+        float f = v - fl;
+        t[a] = f * f * (3.0f - 2.0f * f);
+    }
+    float c[2][2];
+    for (int dz = 0; dz < 2; ++dz)
+        for (int dy = 0; dy < 2; ++dy)
+            c[dz][dy] = lerpf(lattice(key, i[0], i[1] + dy, i[2] + dz), lattice(key, i[0] + 1, i[1] + dy, i[2] + dz),
+                              t[0]);
+    return lerpf(lerpf(c[0][0], c[0][1], t[1]), lerpf(c[1][0], c[1][1], t[1]), t[2]);
+}
+
+float veil_particles_fbm(uint64_t seed, int octaves, const float x[3])
+{
+    float sum = 0.0f, norm = 0.0f, w = 1.0f, freq = 1.0f;
+    for (int o = 0; o < octaves; ++o) {
+        float y[3] = {x[0] * freq, x[1] * freq, x[2] * freq};
+        sum += w * value_noise(mix64(seed + 0x9E3779B97F4A7C15ull * (uint64_t)(o + 1)), y);
+        norm += w;
+        w *= 0.5f, freq *= 2.0f;
+    }
+    if (!(norm > 0.0f)) return 0.0f;
+    float n = sum / norm;
+    return n < 0.99999994f ? (n > 0.0f ? n : 0.0f) : 0.99999994f;
+}
+
+void veil_particles_modulate(veil_particle* p, size_t n, uint64_t seed, float scale, int octaves, float amount)
+{
+    if (!(amount > 0.0f) || !(scale > 0.0f) || octaves < 1) return;
+    for (size_t i = 0; i < n; ++i) {
+        float x[3] = {p[i].center[0] / scale, p[i].center[1] / scale, p[i].center[2] / scale};
+        p[i].amplitude *= (1.0f - amount) + amount * veil_particles_fbm(seed, octaves, x);
+    }
+}
