@@ -1,5 +1,7 @@
 #include "json_read.h"
 
+#include <errno.h>
+
 #include <float.h>
 #include <math.h>
 #include <stdarg.h>
@@ -235,3 +237,39 @@ veil_result veil__jr_alloc_items(const ctx* c, const jpath* p, const cJSON* arr,
 
 /* ---- the scene --------------------------------------------------------- */
 
+
+veil_result veil__read_file(const char* path, size_t limit, const char* kind, char** buf, size_t* len,
+                            veil_error* err)
+{
+    errno = 0;
+    FILE* f = fopen(path, "rb");
+    if (!f) return veil_fail(err, VEIL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    size_t cap = (size_t)1 << 16, n = 0;
+    char* b = NULL;
+    veil_result r = VEIL_OK;
+    for (;;) {
+        char* nb = realloc(b, cap + 1);
+        if (!nb) {
+            r = veil_fail(err, VEIL_ERR_OOM, "%s: out of memory reading %zu bytes", path, cap);
+            break;
+        }
+        b = nb;
+        n += fread(b + n, 1, cap - n, f);
+        if (n < cap) break; /* end of file or error */
+        if (n > limit) {
+            r = veil_fail(err, VEIL_ERR_LIMIT, "%s: file is larger than %zu MiB, the limit for %s files", path,
+                          limit >> 20, kind);
+            break;
+        }
+        cap = cap > limit / 2 ? limit + 1 : 2 * cap;
+    }
+    if (r == VEIL_OK && ferror(f)) r = veil_fail(err, VEIL_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
+    fclose(f);
+    if (r != VEIL_OK) {
+        free(b);
+        return r;
+    }
+    b[n] = '\0';
+    *buf = b, *len = n;
+    return VEIL_OK;
+}

@@ -56,6 +56,12 @@ extern const range VEIL__R_SEED;
 #define VEIL__JR_PRINTF __attribute__((format(printf, 3, 4)))
 #else
 #define VEIL__JR_PRINTF
+/* The whole file `path`, NUL-terminated, into a malloc'd *buf (*len bytes
+ * before the NUL); at most `limit` bytes, refused above with a message
+ * naming the limit for `kind` files ("scene", "particle"). */
+veil_result veil__read_file(const char* path, size_t limit, const char* kind, char** buf, size_t* len,
+                            veil_error* err);
+
 #endif
 
 size_t veil__jr_path_format(const jpath* p, char* buf, size_t n);
@@ -74,5 +80,11 @@ veil_result veil__jr_parse_floats(const ctx* c, const cJSON* v, const jpath* p, 
 veil_result veil__jr_get_floats(const ctx* c, const cJSON* obj, const jpath* pp, const char* key, bool required, int n, bool nonneg, float* out);
 veil_result veil__jr_get_kind(const ctx* c, const cJSON* obj, const jpath* pp, const char* const* names, int* kind);
 veil_result veil__jr_alloc_items(const ctx* c, const jpath* p, const cJSON* arr, size_t size, size_t limit, void** items, size_t* count);
+
+/* The whole file `path`, NUL-terminated, into a malloc'd *buf (*len bytes
+ * before the NUL); at most `limit` bytes, refused above with a message
+ * naming the limit for `kind` files ("scene", "particle"). */
+veil_result veil__read_file(const char* path, size_t limit, const char* kind, char** buf, size_t* len,
+                            veil_error* err);
 
 #endif

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "json_read.h"
+#include "scene_sources.h"
 #include "scene.h"
 #include "tempfile.h"
 
@@ -20,7 +21,6 @@
 #define PARTICLES_MAX_FILE_BYTES ((size_t)2 << 30)
 
 static const char* const FILE_KEYS[] = {"format", "version", "particles", NULL};
-static const char* const PARTICLE_KEYS[] = {"center", "amplitude", "sharpness", NULL};
 static const char* const FIELD_NAMES[5] = {"center[0]", "center[1]", "center[2]", "amplitude", "sharpness"};
 
 /* ---- checks shared by reader and writer -------------------------------- */
@@ -66,41 +66,6 @@ static void put_f32(unsigned char* b, float f)
 }
 
 /* ---- reading ----------------------------------------------------------- */
-
-static veil_result read_whole(const char* path, unsigned char** buf, size_t* len, veil_error* err)
-{
-    errno = 0;
-    FILE* f = fopen(path, "rb");
-    if (!f) return veil_fail(err, VEIL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    size_t cap = (size_t)1 << 16, n = 0;
-    unsigned char* b = NULL;
-    veil_result r = VEIL_OK;
-    for (;;) {
-        unsigned char* nb = realloc(b, cap + 1);
-        if (!nb) {
-            r = veil_fail(err, VEIL_ERR_OOM, "%s: out of memory reading %zu bytes", path, cap);
-            break;
-        }
-        b = nb;
-        n += fread(b + n, 1, cap - n, f);
-        if (n < cap) break; /* end of file or error */
-        if (n > PARTICLES_MAX_FILE_BYTES) {
-            r = veil_fail(err, VEIL_ERR_LIMIT, "%s: file is larger than %zu MiB, the limit for particle files",
-                          path, PARTICLES_MAX_FILE_BYTES >> 20);
-            break;
-        }
-        cap = cap > PARTICLES_MAX_FILE_BYTES / 2 ? PARTICLES_MAX_FILE_BYTES + 1 : 2 * cap;
-    }
-    if (r == VEIL_OK && ferror(f)) r = veil_fail(err, VEIL_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
-    fclose(f);
-    if (r != VEIL_OK) {
-        free(b);
-        return r;
-    }
-    b[n] = '\0';
-    *buf = b, *len = n;
-    return VEIL_OK;
-}
 
 static veil_result read_binary(const char* path, const unsigned char* b, size_t len, veil_particle** out,
                                size_t* count, veil_error* err)
@@ -168,33 +133,7 @@ static veil_result parse_json_particles(const ctx* c, const cJSON* root, veil_pa
         return veil__jr_expected(c, &fp, "the string \"veil-particles\"", v);
     TRY(veil__jr_lookup(c, root, &vp, true, "the number 1", &v));
     if (!cJSON_IsNumber(v) || v->valuedouble != 1.0) return veil__jr_expected(c, &vp, "the number 1", v);
-    const cJSON* arr, *e;
-    TRY(veil__jr_get_container(c, root, &pp, true, true, &arr));
-    void* items = NULL;
-    TRY(veil__jr_alloc_items(c, &pp, arr, sizeof **out, VEIL_SCENE_MAX_PARTICLES, &items, count));
-    *out = items;
-    size_t i = 0;
-    cJSON_ArrayForEach(e, arr) {
-        const jpath ep = {&pp, NULL, i};
-        veil_particle* q = &(*out)[i++];
-        double amp, sharp;
-        if (!cJSON_IsObject(e)) return veil__jr_expected(c, &ep, "an object", e);
-        TRY(veil__jr_check_keys(c, e, &ep, PARTICLE_KEYS));
-        TRY(veil__jr_get_floats(c, e, &ep, "center", true, 3, false, q->center));
-        TRY(veil__jr_get_number(c, e, &ep, "amplitude", true, &VEIL__R_NONNEG, &amp));
-        TRY(veil__jr_get_number(c, e, &ep, "sharpness", true, &VEIL__R_POS, &sharp));
-        q->amplitude = (float)amp, q->sharpness = (float)sharp;
-        const char* why;
-        int k = bad_field(q, &why);
-        if (k >= 0) {
-            const jpath kp = {&ep, k < 3 ? "center" : FIELD_NAMES[k], 0};
-            return veil__jr_fail_at(c, &kp, "expected %s that fits a 32-bit float, got %g", why,
-                                    k == 3 ? amp : k == 4 ? sharp : (double)q->center[k]);
-        }
-        if (q->sharpness == 0.0f) /* a tiny positive double that rounds to 0 */
-            return veil__jr_fail_at(c, &ep, "sharpness %g rounds to 0 as a 32-bit float", sharp);
-    }
-    return VEIL_OK;
+    return veil__parse_particle_array(c, root, &pp, out, count);
 }
 
 static veil_result read_json(const char* path, const char* s, size_t len, veil_particle** out, size_t* count,
@@ -227,9 +166,10 @@ veil_result veil_particles_read(const char* path, veil_particle** out, size_t* c
 {
     if (!path || !out || !count) return veil_fail(err, VEIL_ERR_INVALID, "veil_particles_read: NULL argument");
     *out = NULL, *count = 0;
-    unsigned char* b = NULL;
+    char* text = NULL;
     size_t len = 0;
-    TRY(read_whole(path, &b, &len, err));
+    TRY(veil__read_file(path, PARTICLES_MAX_FILE_BYTES, "particle", &text, &len, err));
+    const unsigned char* b = (const unsigned char*)text;
     veil_result r;
     size_t first = 0;
     while (first < len && strchr(" \t\r\n", b[first]) && b[first]) ++first;
@@ -243,7 +183,7 @@ veil_result veil_particles_read(const char* path, veil_particle** out, size_t* c
         r = veil_fail(err, VEIL_ERR_INVALID,
                       "%s: not a particle file (expected the magic \"" VEIL_PARTICLES_MAGIC
                       "\" or a JSON object, see docs/particles.md)", path);
-    free(b);
+    free(text);
     return r;
 }
 

@@ -252,49 +252,13 @@ veil_result veil_scene_parse(const char* name, const char* json, size_t len,
     return VEIL_OK;
 }
 
-/* Reads all of f into a NUL-terminated buffer, at most SCENE_MAX_FILE_BYTES. */
-static veil_result read_all(const char* path, FILE* f, char** buf, size_t* len, veil_error* err)
-{
-    size_t cap = (size_t)1 << 16, n = 0;
-    char* b = NULL;
-    veil_result r = VEIL_OK;
-    for (;;) {
-        char* nb = realloc(b, cap + 1);
-        if (!nb) {
-            r = veil_fail(err, VEIL_ERR_OOM, "%s: out of memory reading %zu bytes", path, cap);
-            break;
-        }
-        b = nb;
-        n += fread(b + n, 1, cap - n, f);
-        if (n < cap) break; /* end of file or error */
-        if (n > SCENE_MAX_FILE_BYTES) {
-            r = veil_fail(err, VEIL_ERR_LIMIT, "%s: file is larger than %zu MiB, the limit for scene files",
-                          path, SCENE_MAX_FILE_BYTES >> 20);
-            break;
-        }
-        cap = cap > SCENE_MAX_FILE_BYTES / 2 ? SCENE_MAX_FILE_BYTES + 1 : 2 * cap;
-    }
-    if (r == VEIL_OK && ferror(f)) r = veil_fail(err, VEIL_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
-    if (r != VEIL_OK) {
-        free(b);
-        return r;
-    }
-    b[n] = '\0';
-    *buf = b, *len = n;
-    return VEIL_OK;
-}
-
 veil_result veil_scene_load(const char* path, veil_scene* out, veil_error* err)
 {
     if (!out || !path) return veil_fail(err, VEIL_ERR_INVALID, "veil_scene_load: NULL argument");
     memset(out, 0, sizeof *out);
-    errno = 0;
-    FILE* f = fopen(path, "rb");
-    if (!f) return veil_fail(err, VEIL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
     char* buf = NULL;
     size_t len = 0;
-    veil_result r = read_all(path, f, &buf, &len, err);
-    fclose(f);
+    veil_result r = veil__read_file(path, SCENE_MAX_FILE_BYTES, "scene", &buf, &len, err);
     if (r != VEIL_OK) return r;
     r = veil_scene_parse(path, buf, len, out, err);
     free(buf);

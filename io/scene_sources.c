@@ -17,18 +17,18 @@ static const char* const RBF_KEYS[] = {"type", "particles", "file", NULL};
 static const char* const RANDOM_KEYS[] = {"type", "count", "seed", "bounds", "radius", "amplitude", NULL};
 static const char* const PARTICLE_KEYS[] = {"center", "amplitude", "sharpness", NULL};
 
-static veil_result parse_particles(const ctx* c, const cJSON* so, const jpath* sp, veil_source* src)
+veil_result veil__parse_particle_array(const ctx* c, const cJSON* obj, const jpath* p, veil_particle** out,
+                                      size_t* count)
 {
-    const jpath p = {sp, "particles", 0};
     const cJSON* arr, *e;
     size_t i = 0;
-    TRY(veil__jr_get_container(c, so, &p, true, true, &arr));
+    TRY(veil__jr_get_container(c, obj, p, true, true, &arr));
     void* items = NULL;
-    TRY(veil__jr_alloc_items(c, &p, arr, sizeof *src->particles, VEIL_SCENE_MAX_PARTICLES, &items, &src->particle_count));
-    src->particles = items;
+    TRY(veil__jr_alloc_items(c, p, arr, sizeof **out, VEIL_SCENE_MAX_PARTICLES, &items, count));
+    *out = items;
     cJSON_ArrayForEach(e, arr) {
-        const jpath ep = {&p, NULL, i};
-        veil_particle* q = &src->particles[i++];
+        const jpath ep = {p, NULL, i};
+        veil_particle* q = &(*out)[i++];
         double amp, sharp;
         if (!cJSON_IsObject(e)) return veil__jr_expected(c, &ep, "an object", e);
         TRY(veil__jr_check_keys(c, e, &ep, PARTICLE_KEYS));
@@ -38,6 +38,12 @@ static veil_result parse_particles(const ctx* c, const cJSON* so, const jpath* s
         q->amplitude = (float)amp, q->sharpness = (float)sharp;
     }
     return VEIL_OK;
+}
+
+static veil_result parse_particles(const ctx* c, const cJSON* so, const jpath* sp, veil_source* src)
+{
+    const jpath p = {sp, "particles", 0};
+    return veil__parse_particle_array(c, so, &p, &src->particles, &src->particle_count);
 }
 
 static veil_result parse_bounds(const ctx* c, const cJSON* so, const jpath* sp, float b[2][3])
