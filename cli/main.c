@@ -29,12 +29,16 @@
 #include "render/gl_context.h"
 #include "render/gl_util.h"
 #include "render/renderer.h"
+#include "cli_util.h"
+#include "commands.h"
 
-enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2, EXIT_GPU = 3 };
 
 static const char* usage_text =
     "usage: veil render SCENE.json -o OUT.exr [--png OUT.png] [--width W] [--height H]\n"
     "                   [--step S] [--seed N] [--method M] [--turntable N] [--stats]\n"
+    "       veil reference SCENE.json -o REF.exr --spp N [--max-order K] [--width W]\n"
+    "                [--height H] [--seed N] [--threads T]\n"
+    "       veil compare A.exr REF.exr [--heatmap OUT.png] [--floor F] [--json]\n"
     "       veil gpuinfo\n"
     "       veil info FILE.vdb [--json]\n"
     "       veil rbf generate -o OUT --count N --seed S --bounds x0,y0,z0,x1,y1,z1\n"
@@ -55,6 +59,21 @@ static const char* usage_text =
     "                 up axis, written as OUT_0000.exr ... (volume and optical depth\n"
     "                 are computed once and reused: see --stats)\n"
     "  --stats        print the wall time of each stage in milliseconds\n"
+    "reference  renders a scene with the CPU path tracer (reference/pathtracer.h), the\n"
+    "         ground truth the GPU path is measured against. The EXR holds R, G, B, A and\n"
+    "         the per-pixel standard error of each mean (stderr.R, stderr.G, stderr.B).\n"
+    "  --spp N        samples per pixel (2..1000000, required)\n"
+    "  --max-order K  scatterings counted: 1 single scattering (the GPU marcher's\n"
+    "                 quantity), 0 all (default 0)\n"
+    "  --seed N       (default 0); the same seed gives the same image on any thread count\n"
+    "  --threads T    worker threads (default: one per core)\n"
+    "compare  compares image A against reference REF (both EXR, same size): relative\n"
+    "         RMSE (denominator floored at --floor, default 1% of REF's mean), max abs\n"
+    "         error, fraction of pixels more than 5% off, PSNR.\n"
+    "  --floor F      the denominator's floor, absolute (default 1% of REF's mean RGB)\n"
+    "  --heatmap OUT.png  per-pixel relative error as a colour map, log scale:\n"
+    "                 black 1e-4 (and 0), blue 1e-3, magenta 1e-2, yellow 1e-1, white 1\n"
+    "  --json         print the numbers as JSON (psnr_db null for identical RGB)\n"
     "gpuinfo  prints the EGL platform and device, GL vendor, renderer, version and\n"
     "         the largest 3D texture. VEIL_DEVICE=software forces llvmpipe.\n"
     "info     lists the grids of an OpenVDB file: name, class, value type, active\n"
@@ -70,55 +89,6 @@ static const char* usage_text =
     "  --format F     json or binary (default: json when OUT ends in .json)\n"
     "\n"
     "exit codes: 0 success, 1 bad input, 2 usage, 3 GPU or driver failure\n";
-
-static int usage_error(const char* fmt, const char* arg)
-{
-    fputs("veil: ", stderr);
-    fprintf(stderr, fmt, arg);
-    fputs("\n(run 'veil --help' for usage)\n", stderr);
-    return EXIT_USAGE;
-}
-
-static int exit_code(veil_result r)
-{
-    return (r == VEIL_ERR_GPU || r == VEIL_ERR_SHADER) ? EXIT_GPU : EXIT_INPUT;
-}
-
-static int fail(veil_result r, const veil_error* err)
-{
-    fprintf(stderr, "veil: %s\n", err->msg[0] ? err->msg : veil_result_message(r));
-    return exit_code(r);
-}
-
-/* "what went wrong" -> "scene.json: what went wrong", for errors that the
- * scene's content caused but that were found while rendering it. */
-static void prefix_error(veil_error* err, const char* file)
-{
-    char tmp[VEIL_ERROR_MAX];
-    snprintf(tmp, sizeof tmp, "%.500s: %.1500s", file, err->msg);
-    memcpy(err->msg, tmp, sizeof tmp);
-}
-
-/* Parses a whole decimal integer in [lo, hi]. */
-static int parse_int(const char* s, long lo, long hi, long* out)
-{
-    char* end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || end == s || *end || v < lo || v > hi) return 0;
-    *out = v;
-    return 1;
-}
-
-static int parse_float(const char* s, float lo, float hi, float* out)
-{
-    char* end;
-    errno = 0;
-    float v = strtof(s, &end);
-    if (errno || end == s || *end || !(v >= lo && v <= hi)) return 0;
-    *out = v;
-    return 1;
-}
 
 static int cmd_gpuinfo(void)
 {
@@ -165,16 +135,16 @@ static int cmd_info(int argc, char** argv)
     int json = 0;
     for (int i = 2; i < argc; ++i) {
         if (!strcmp(argv[i], "--json")) json = 1;
-        else if (argv[i][0] == '-' && argv[i][1]) return usage_error("unknown option '%s'", argv[i]);
+        else if (argv[i][0] == '-' && argv[i][1]) return veil_cli_usage_error("unknown option '%s'", argv[i]);
         else if (!path) path = argv[i];
-        else return usage_error("unexpected argument '%s'", argv[i]);
+        else return veil_cli_usage_error("unexpected argument '%s'", argv[i]);
     }
-    if (!path) return usage_error("%s", "info: missing FILE.vdb");
+    if (!path) return veil_cli_usage_error("%s", "info: missing FILE.vdb");
     veil_error err = {0};
     if (json) {
         char* text = NULL;
         veil_result r = veil_vdb_info_json(path, &text, &err);
-        if (r != VEIL_OK) return fail(r, &err);
+        if (r != VEIL_OK) return veil_cli_fail(r, &err);
         puts(text);
         free(text);
         return EXIT_OK;
@@ -182,7 +152,7 @@ static int cmd_info(int argc, char** argv)
     veil_vdb_grid_info* grids = NULL;
     size_t n = 0;
     veil_result r = veil_vdb_file_info(path, &grids, &n, &err);
-    if (r != VEIL_OK) return fail(r, &err);
+    if (r != VEIL_OK) return veil_cli_fail(r, &err);
     int w = 4; /* name column: the longest name */
     for (size_t i = 0; i < n; ++i) w = (int)strlen(grids[i].name) > w ? (int)strlen(grids[i].name) : w;
     printf("%s: %zu grid%s\n\n", path, n, n == 1 ? "" : "s");
@@ -221,49 +191,34 @@ static int parse_render_args(int argc, char** argv, render_args* a)
         int takes = !strcmp(s, "-o") || !strcmp(s, "--png") || !strcmp(s, "--width") || !strcmp(s, "--height") ||
                     !strcmp(s, "--step") || !strcmp(s, "--seed") || !strcmp(s, "--method") ||
                     !strcmp(s, "--turntable");
-        if (takes && !v) return usage_error("%s needs a value", s);
+        if (takes && !v) return veil_cli_usage_error("%s needs a value", s);
         if (!strcmp(s, "-o")) a->exr = v;
         else if (!strcmp(s, "--png")) a->png = v;
         else if (!strcmp(s, "--width")) {
-            if (!parse_int(v, 1, VEIL_SCENE_MAX_IMAGE, &a->width)) return usage_error("--width: expected an integer in 1..16384, got '%s'", v);
+            if (!veil_cli_parse_int(v, 1, VEIL_SCENE_MAX_IMAGE, &a->width)) return veil_cli_usage_error("--width: expected an integer in 1..16384, got '%s'", v);
         } else if (!strcmp(s, "--height")) {
-            if (!parse_int(v, 1, VEIL_SCENE_MAX_IMAGE, &a->height)) return usage_error("--height: expected an integer in 1..16384, got '%s'", v);
+            if (!veil_cli_parse_int(v, 1, VEIL_SCENE_MAX_IMAGE, &a->height)) return veil_cli_usage_error("--height: expected an integer in 1..16384, got '%s'", v);
         } else if (!strcmp(s, "--step")) {
-            if (!parse_float(v, 0.01f, 16.0f, &a->step)) return usage_error("--step: expected a number of voxels in 0.01..16, got '%s'", v);
+            if (!veil_cli_parse_float(v, 0.01f, 16.0f, &a->step)) return veil_cli_usage_error("--step: expected a number of voxels in 0.01..16, got '%s'", v);
         } else if (!strcmp(s, "--seed")) {
-            if (!parse_int(v, 0, 4294967295L, &a->seed)) return usage_error("--seed: expected an integer in 0..4294967295, got '%s'", v);
+            if (!veil_cli_parse_int(v, 0, 4294967295L, &a->seed)) return veil_cli_usage_error("--seed: expected an integer in 0..4294967295, got '%s'", v);
         } else if (!strcmp(s, "--turntable")) {
-            if (!parse_int(v, 1, 100000, &a->frames)) return usage_error("--turntable: expected a number of frames in 1..100000, got '%s'", v);
+            if (!veil_cli_parse_int(v, 1, 100000, &a->frames)) return veil_cli_usage_error("--turntable: expected a number of frames in 1..100000, got '%s'", v);
         } else if (!strcmp(s, "--method")) {
             if (!veil_opv_method_parse(v, &a->method))
-                return usage_error("--method: expected default, jacobi, jacobi-corrected, sweep or semi-lagrangian, got '%s'", v);
-        } else if (s[0] == '-' && s[1]) return usage_error("unknown option '%s'", s);
+                return veil_cli_usage_error("--method: expected default, jacobi, jacobi-corrected, sweep or semi-lagrangian, got '%s'", v);
+        } else if (s[0] == '-' && s[1]) return veil_cli_usage_error("unknown option '%s'", s);
         else if (!a->scene) { a->scene = s; continue; }
-        else return usage_error("unexpected argument '%s'", s);
+        else return veil_cli_usage_error("unexpected argument '%s'", s);
         ++i;
     }
-    if (!a->scene) return usage_error("%s", "render: missing SCENE.json");
-    if (!a->exr) return usage_error("%s", "render: missing -o OUT.exr");
+    if (!a->scene) return veil_cli_usage_error("%s", "render: missing SCENE.json");
+    if (!a->exr) return veil_cli_usage_error("%s", "render: missing -o OUT.exr");
     return -1;
 }
 
 /* The folder an output goes into must exist: found before rendering, not
  * after seconds of work. */
-static veil_result check_output_folder(const char* path, veil_error* err)
-{
-    char dir[4096];
-    const char* slash = strrchr(path, '/');
-    if (!slash) return VEIL_OK;
-    size_t n = slash == path ? 1 : (size_t)(slash - path);
-    if (n >= sizeof dir) return veil_fail(err, VEIL_ERR_IO, "%s: path too long", path);
-    memcpy(dir, path, n);
-    dir[n] = '\0';
-    struct stat st;
-    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
-        return veil_fail(err, VEIL_ERR_IO, "%s: the folder '%s' does not exist", path, dir);
-    return VEIL_OK;
-}
-
 /* "out/t.exr", frame 7 -> "out/t_0007.exr" (a turntable's frame files). */
 static void frame_path(const char* path, long frame, int numbered, char* out, size_t n)
 {
@@ -326,11 +281,11 @@ static int cmd_render(int argc, char** argv)
     double t_start = veil_now_ms();
     veil_error err = {0};
     veil_scene scene;
-    veil_result r = check_output_folder(a.exr, &err);
-    if (r == VEIL_OK && a.png) r = check_output_folder(a.png, &err);
-    if (r != VEIL_OK) return fail(r, &err);
+    veil_result r = veil_cli_check_output_folder(a.exr, &err);
+    if (r == VEIL_OK && a.png) r = veil_cli_check_output_folder(a.png, &err);
+    if (r != VEIL_OK) return veil_cli_fail(r, &err);
     r = veil_scene_load(a.scene, &scene, &err);
-    if (r != VEIL_OK) return fail(r, &err);
+    if (r != VEIL_OK) return veil_cli_fail(r, &err);
 
     veil_gl* gl = NULL;
     veil_renderer* ren = NULL;
@@ -345,7 +300,7 @@ static int cmd_render(int argc, char** argv)
         veil_render_stats st = {0};
         float* rgba = NULL;
         r = veil_render_scene(ren, &scene, &opts, &rgba, &st, &err);
-        if (r != VEIL_OK && exit_code(r) == EXIT_INPUT) prefix_error(&err, a.scene);
+        if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
         char exr[4096], png[4096];
         frame_path(a.exr, f, a.frames > 0, exr, sizeof exr);
         if (a.png) frame_path(a.png, f, a.frames > 0, png, sizeof png);
@@ -368,14 +323,14 @@ static int cmd_render(int argc, char** argv)
     veil_renderer_destroy(ren);
     veil_gl_destroy(gl);
     veil_scene_free(&scene);
-    return r == VEIL_OK ? EXIT_OK : fail(r, &err);
+    return r == VEIL_OK ? EXIT_OK : veil_cli_fail(r, &err);
 }
 
 /* veil rbf generate: a seeded random particle file, optionally fBm-modulated. */
 static int cmd_rbf(int argc, char** argv)
 {
     if (argc < 3 || strcmp(argv[2], "generate") != 0)
-        return usage_error("rbf: expected the subcommand 'generate', got '%s'", argc < 3 ? "" : argv[2]);
+        return veil_cli_usage_error("rbf: expected the subcommand 'generate', got '%s'", argc < 3 ? "" : argv[2]);
     const char* out = NULL;
     long count = -1, seed = -1, octaves = 4, format = -1; /* format: -1 by extension, 0 json, 1 binary */
     float v6[6] = {0}, bounds[6] = {0}, radius[2] = {0}, amp[2] = {0}, scale = 1.0f, amount = 0.0f;
@@ -388,10 +343,10 @@ static int cmd_rbf(int argc, char** argv)
                     !strcmp(s, "--noise-scale") || !strcmp(s, "--noise-octaves") || !strcmp(s, "--noise-amount") ||
                     !strcmp(s, "--format");
         if (!takes) {
-            if (s[0] == '-' && s[1]) return usage_error("unknown option '%s'", s);
-            return usage_error("unexpected argument '%s'", s);
+            if (s[0] == '-' && s[1]) return veil_cli_usage_error("unknown option '%s'", s);
+            return veil_cli_usage_error("unexpected argument '%s'", s);
         }
-        if (!v) return usage_error("%s needs a value", s);
+        if (!v) return veil_cli_usage_error("%s needs a value", s);
         ++i;
         if (nlist) { /* comma-separated finite numbers */
             const char* p = v;
@@ -409,42 +364,42 @@ static int cmd_rbf(int argc, char** argv)
             if (ok && nlist == 6) {
                 for (int a = 0; a < 3; ++a) ok = ok && v6[a] <= v6[a + 3];
                 if (!ok)
-                    return usage_error("--bounds: expected x0,y0,z0,x1,y1,z1 (min and max corner, m) with min <= max, got '%s'", v);
+                    return veil_cli_usage_error("--bounds: expected x0,y0,z0,x1,y1,z1 (min and max corner, m) with min <= max, got '%s'", v);
                 memcpy(bounds, v6, sizeof bounds), have_b = 1;
             } else if (ok && !strcmp(s, "--radius")) {
                 if (!(v6[0] > 0 && v6[0] <= v6[1] && isfinite(1.0f / v6[0])))
-                    return usage_error("--radius: expected r0,r1 with 0 < r0 <= r1 (m), got '%s'", v);
+                    return veil_cli_usage_error("--radius: expected r0,r1 with 0 < r0 <= r1 (m), got '%s'", v);
                 memcpy(radius, v6, sizeof radius), have_r = 1;
             } else if (ok) {
                 if (!(v6[0] >= 0 && v6[0] <= v6[1]))
-                    return usage_error("--amplitude: expected c0,c1 with 0 <= c0 <= c1, got '%s'", v);
+                    return veil_cli_usage_error("--amplitude: expected c0,c1 with 0 <= c0 <= c1, got '%s'", v);
                 memcpy(amp, v6, sizeof amp), have_a = 1;
             } else if (nlist == 6) {
-                return usage_error("--bounds: expected 6 comma-separated numbers x0,y0,z0,x1,y1,z1, got '%s'", v);
+                return veil_cli_usage_error("--bounds: expected 6 comma-separated numbers x0,y0,z0,x1,y1,z1, got '%s'", v);
             } else {
-                return usage_error(!strcmp(s, "--radius") ? "--radius: expected 2 comma-separated numbers r0,r1, got '%s'"
+                return veil_cli_usage_error(!strcmp(s, "--radius") ? "--radius: expected 2 comma-separated numbers r0,r1, got '%s'"
                                                           : "--amplitude: expected 2 comma-separated numbers c0,c1, got '%s'", v);
             }
         } else if (!strcmp(s, "-o")) out = v;
         else if (!strcmp(s, "--count")) {
-            if (!parse_int(v, 0, VEIL_SCENE_MAX_PARTICLES, &count)) return usage_error("--count: expected an integer in 0..10000000, got '%s'", v);
+            if (!veil_cli_parse_int(v, 0, VEIL_SCENE_MAX_PARTICLES, &count)) return veil_cli_usage_error("--count: expected an integer in 0..10000000, got '%s'", v);
         } else if (!strcmp(s, "--seed")) {
-            if (!parse_int(v, 0, 9007199254740991L, &seed)) return usage_error("--seed: expected an integer in 0..2^53-1, got '%s'", v);
+            if (!veil_cli_parse_int(v, 0, 9007199254740991L, &seed)) return veil_cli_usage_error("--seed: expected an integer in 0..2^53-1, got '%s'", v);
         } else if (!strcmp(s, "--noise-octaves")) {
-            if (!parse_int(v, 1, 16, &octaves)) return usage_error("--noise-octaves: expected an integer in 1..16, got '%s'", v);
+            if (!veil_cli_parse_int(v, 1, 16, &octaves)) return veil_cli_usage_error("--noise-octaves: expected an integer in 1..16, got '%s'", v);
         } else if (!strcmp(s, "--noise-amount")) {
-            if (!parse_float(v, 0.0f, 1.0f, &amount)) return usage_error("--noise-amount: expected a number in 0..1, got '%s'", v);
+            if (!veil_cli_parse_float(v, 0.0f, 1.0f, &amount)) return veil_cli_usage_error("--noise-amount: expected a number in 0..1, got '%s'", v);
         } else if (!strcmp(s, "--noise-scale")) {
-            if (!parse_float(v, 1e-30f, 3.4e38f, &scale)) return usage_error("--noise-scale: expected a length > 0 (m), got '%s'", v);
+            if (!veil_cli_parse_float(v, 1e-30f, 3.4e38f, &scale)) return veil_cli_usage_error("--noise-scale: expected a length > 0 (m), got '%s'", v);
         } else if (!strcmp(v, "json") || !strcmp(v, "binary")) format = !strcmp(v, "binary");
-        else return usage_error("--format: expected json or binary, got '%s'", v);
+        else return veil_cli_usage_error("--format: expected json or binary, got '%s'", v);
     }
-    if (!out) return usage_error("%s", "rbf generate: missing -o OUT");
-    if (count < 0) return usage_error("%s", "rbf generate: missing --count N");
-    if (seed < 0) return usage_error("%s", "rbf generate: missing --seed S");
-    if (!have_b) return usage_error("%s", "rbf generate: missing --bounds x0,y0,z0,x1,y1,z1");
-    if (!have_r) return usage_error("%s", "rbf generate: missing --radius r0,r1");
-    if (!have_a) return usage_error("%s", "rbf generate: missing --amplitude c0,c1");
+    if (!out) return veil_cli_usage_error("%s", "rbf generate: missing -o OUT");
+    if (count < 0) return veil_cli_usage_error("%s", "rbf generate: missing --count N");
+    if (seed < 0) return veil_cli_usage_error("%s", "rbf generate: missing --seed S");
+    if (!have_b) return veil_cli_usage_error("%s", "rbf generate: missing --bounds x0,y0,z0,x1,y1,z1");
+    if (!have_r) return veil_cli_usage_error("%s", "rbf generate: missing --radius r0,r1");
+    if (!have_a) return veil_cli_usage_error("%s", "rbf generate: missing --amplitude c0,c1");
     if (format < 0) {
         size_t n = strlen(out);
         format = !(n >= 5 && !strcmp(out + n - 5, ".json"));
@@ -454,12 +409,12 @@ static int cmd_rbf(int argc, char** argv)
                               .radius = {radius[0], radius[1]}, .amplitude = {amp[0], amp[1]}};
     veil_particle* p = count ? malloc((size_t)count * sizeof *p) : NULL;
     veil_error err = {0};
-    if (count && !p) return fail(veil_fail(&err, VEIL_ERR_OOM, "out of memory for %ld particles", count), &err);
+    if (count && !p) return veil_cli_fail(veil_fail(&err, VEIL_ERR_OOM, "out of memory for %ld particles", count), &err);
     veil_rbf_random_generate(&d, p);
     veil_particles_modulate(p, (size_t)count, (uint64_t)seed, scale, (int)octaves, amount);
     veil_result r = veil_particles_write(out, p, (size_t)count, (int)format, &err);
     free(p);
-    if (r != VEIL_OK) return fail(r, &err);
+    if (r != VEIL_OK) return veil_cli_fail(r, &err);
     printf("wrote %s (%ld particles, %s)\n", out, count, format ? "binary" : "json");
     return EXIT_OK;
 }
@@ -482,9 +437,11 @@ int main(int argc, char** argv)
     if (!strcmp(cmd, "render")) return cmd_render(argc, argv);
     if (!strcmp(cmd, "info")) return cmd_info(argc, argv);
     if (!strcmp(cmd, "rbf")) return cmd_rbf(argc, argv);
+    if (!strcmp(cmd, "reference")) return veil_cmd_reference(argc, argv);
+    if (!strcmp(cmd, "compare")) return veil_cmd_compare(argc, argv);
     if (!strcmp(cmd, "gpuinfo")) {
-        if (argc > 2) return usage_error("gpuinfo takes no arguments, got '%s'", argv[2]);
+        if (argc > 2) return veil_cli_usage_error("gpuinfo takes no arguments, got '%s'", argv[2]);
         return cmd_gpuinfo();
     }
-    return usage_error("unknown command '%s'", cmd);
+    return veil_cli_usage_error("unknown command '%s'", cmd);
 }

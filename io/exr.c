@@ -1,20 +1,23 @@
 /* veil — OpenEXR output and input through OpenEXRCore (the C API only).
  *
- * Writing: one scanline part, channels R, G, B, A (stored A, B, G, R: the
- * format sorts channel names) as 32-bit float, ZIP compression, data window
- * (0,0)-(w-1,h-1). The bytes go through a custom stream onto a temporary
- * file beside the target, which is renamed into place only when every step
- * succeeded; on failure it is removed.
+ * Writing: one scanline part of named 32-bit float channels (the format
+ * stores them sorted by name: R, G, B, A as A, B, G, R), ZIP compression,
+ * data window (0,0)-(w-1,h-1). veil_write_exr writes the de-interleaved
+ * R, G, B, A planes through veil_write_exr_planes: there is one writer. The
+ * bytes go through a custom stream onto a temporary file beside the target,
+ * which is renamed into place only when every step succeeded; on failure it
+ * is removed.
  *
  * Reading: the first part of a scanline or tiled file (level 0 of a mip/rip
- * map), half or float R, G, B and optional A. OpenEXRCore reads and
- * decompresses each chunk; the last step (storage order to interleaved
- * RGBA float) is our own unpack routine, because the specialised routines of
- * OpenEXRCore 3.1.x get this layout wrong: its "4 channel reversed
- * interleave" half->float path writes A into R and R into A (channels are
- * stored A, B, G, R), and its 3/4-channel fast paths assume that every
- * channel of the file is wanted, so an extra channel (Z, ...) makes them
- * write through a NULL pointer.
+ * map), some named half or float channels (R, G, B and optional A for
+ * veil_read_exr, one channel for veil_read_exr_channel) into one interleaved
+ * float buffer. OpenEXRCore reads and decompresses each chunk; the last step
+ * (storage order to our float layout) is our own unpack routine, because the
+ * specialised routines of OpenEXRCore 3.1.x get this layout wrong: its
+ * "4 channel reversed interleave" half->float path writes A into R and R
+ * into A (channels are stored A, B, G, R), and its 3/4-channel fast paths
+ * assume that every channel of the file is wanted, so an extra channel
+ * (Z, ...) makes them write through a NULL pointer.
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -90,58 +93,48 @@ static int offset_fits(uint64_t off, uint64_t len)
     return off <= max && len <= max - off;
 }
 
-static int64_t fd_write(exr_const_context_t ctxt, void* userdata, const void* buffer, uint64_t sz,
-                        uint64_t offset, exr_stream_error_func_ptr_t error_cb)
+/* pwrite or pread of sz bytes at offset, in pieces; a read stops short only
+ * at end of file. One of wbuf and rbuf is given. */
+static int64_t fd_io(exr_const_context_t ctxt, fd_stream* s, const void* wbuf, void* rbuf, uint64_t sz,
+                     uint64_t offset, exr_stream_error_func_ptr_t error_cb)
 {
-    fd_stream* s = userdata;
-    const unsigned char* p = buffer;
+    const int writing = rbuf == NULL;
+    const exr_result_t code = writing ? EXR_ERR_WRITE_IO : EXR_ERR_READ_IO;
+    const char* what = writing ? "write" : "read";
     uint64_t done = 0;
     if (!offset_fits(offset, sz)) {
-        if (error_cb) error_cb(ctxt, EXR_ERR_WRITE_IO, "write past the largest file offset");
+        if (error_cb) error_cb(ctxt, code, "%s past the largest file offset", what);
         return -1;
     }
     while (done < sz) {
         uint64_t left = sz - done;
         size_t n = left > (1u << 30) ? (size_t)(1u << 30) : (size_t)left;
-        ssize_t w = pwrite(s->fd, p + done, n, (off_t)(offset + done));
-        if (w < 0 && errno == EINTR) continue;
-        if (w <= 0) {
+        off_t at = (off_t)(offset + done);
+        ssize_t r = writing ? pwrite(s->fd, (const unsigned char*)wbuf + done, n, at)
+                            : pread(s->fd, (unsigned char*)rbuf + done, n, at);
+        if (r < 0 && errno == EINTR) continue;
+        if (r == 0 && !writing) break; /* end of file: the library decides whether that is an error */
+        if (r <= 0) {
             if (error_cb)
-                error_cb(ctxt, EXR_ERR_WRITE_IO, "cannot write %" PRIu64 " bytes at offset %" PRIu64 ": %s",
-                         sz, offset, w < 0 ? strerror(errno) : "no progress");
+                error_cb(ctxt, code, "cannot %s %" PRIu64 " bytes at offset %" PRIu64 ": %s", what, sz, offset,
+                         r < 0 ? strerror(errno) : "no progress");
             return -1;
         }
-        done += (uint64_t)w;
+        done += (uint64_t)r;
     }
     return (int64_t)done;
 }
 
-/* pread semantics: a short count only at end of file. */
-static int64_t fd_read(exr_const_context_t ctxt, void* userdata, void* buffer, uint64_t sz,
-                       uint64_t offset, exr_stream_error_func_ptr_t error_cb)
+static int64_t fd_write(exr_const_context_t ctxt, void* userdata, const void* buffer, uint64_t sz,
+                        uint64_t offset, exr_stream_error_func_ptr_t error_cb)
 {
-    fd_stream* s = userdata;
-    unsigned char* p = buffer;
-    uint64_t done = 0;
-    if (!offset_fits(offset, sz)) {
-        if (error_cb) error_cb(ctxt, EXR_ERR_READ_IO, "read past the largest file offset");
-        return -1;
-    }
-    while (done < sz) {
-        uint64_t left = sz - done;
-        size_t n = left > (1u << 30) ? (size_t)(1u << 30) : (size_t)left;
-        ssize_t r = pread(s->fd, p + done, n, (off_t)(offset + done));
-        if (r < 0 && errno == EINTR) continue;
-        if (r < 0) {
-            if (error_cb)
-                error_cb(ctxt, EXR_ERR_READ_IO, "cannot read %" PRIu64 " bytes at offset %" PRIu64 ": %s",
-                         sz, offset, strerror(errno));
-            return -1;
-        }
-        if (r == 0) break; /* end of file: the library decides whether that is an error */
-        done += (uint64_t)r;
-    }
-    return (int64_t)done;
+    return fd_io(ctxt, userdata, buffer, NULL, sz, offset, error_cb);
+}
+
+static int64_t fd_read(exr_const_context_t ctxt, void* userdata, void* buffer, uint64_t sz, uint64_t offset,
+                       exr_stream_error_func_ptr_t error_cb)
+{
+    return fd_io(ctxt, userdata, NULL, buffer, sz, offset, error_cb);
 }
 
 static int64_t fd_size(exr_const_context_t ctxt, void* userdata)
@@ -153,22 +146,43 @@ static int64_t fd_size(exr_const_context_t ctxt, void* userdata)
 /* ------------------------------------------------------------------------ */
 /* Writing */
 
-/* Offset of a channel within an RGBA pixel, or -1. */
-static int rgba_slot(const char* name)
+#define EXR_MAX_CHANNELS 64   /* veil_write_exr_planes' limit */
+#define EXR_LONG_NAME_MAX 255 /* OpenEXR's limit on a name with long names on */
+#define EXR_SHORT_NAME_MAX 31 /* ... and without (readable by older readers) */
+
+static const char* const rgba_names[4] = {"R", "G", "B", "A"};
+
+/* Index of `name` among names[0..n-1], or -1. */
+static int name_index(const char* const* names, int n, const char* name)
 {
-    if (!name || !name[0] || name[1]) return -1;
-    switch (name[0]) {
-    case 'R': return 0;
-    case 'G': return 1;
-    case 'B': return 2;
-    case 'A': return 3;
-    default: return -1;
-    }
+    for (int i = 0; name && i < n; ++i)
+        if (strcmp(names[i], name) == 0) return i;
+    return -1;
 }
 
-static exr_result_t write_chunks(exr_context_t ctx, int part, int w, int h, const float* rgba,
-                                 const char** stage)
+/* Width and height positive, and the image addressable with `per_pixel`
+ * floats a pixel (a line of them within OpenEXRCore's int32 strides). */
+static veil_result check_size(const char* path, int width, int height, size_t per_pixel, veil_error* err)
 {
+    size_t bytes = 0;
+    if (width <= 0 || height <= 0)
+        return veil_fail(err, VEIL_ERR_INVALID, "%s: invalid image size %dx%d (width and height must be positive)",
+                         path, width, height);
+    if (!veil_mul_sizes((size_t)width, (size_t)height, per_pixel, sizeof(float), &bytes) ||
+        (size_t)width > (size_t)INT32_MAX / (per_pixel * sizeof(float)))
+        return veil_fail(err, VEIL_ERR_INVALID, "%s: image size %dx%d is too large", path, width, height);
+    return VEIL_OK;
+}
+
+typedef struct write_job {
+    int width, height, n;
+    const char* const* names;
+    const float* const* planes; /* n planes of width*height */
+} write_job;
+
+static exr_result_t write_chunks(exr_context_t ctx, int part, const write_job* job, const char** stage)
+{
+    const int w = job->width, h = job->height;
     int32_t lines = 0;
     exr_result_t rv = exr_get_scanlines_per_chunk(ctx, part, &lines);
     if (rv != EXR_ERR_SUCCESS) return rv;
@@ -186,33 +200,24 @@ static exr_result_t write_chunks(exr_context_t ctx, int part, int w, int h, cons
             rv = EXR_ERR_INCORRECT_CHUNK;
             break;
         }
-        if (!have_pipeline) {
-            rv = exr_encoding_initialize(ctx, part, &ci, &enc);
-            if (rv != EXR_ERR_SUCCESS) break;
-            have_pipeline = 1;
-        } else {
-            rv = exr_encoding_update(ctx, part, &ci, &enc);
-            if (rv != EXR_ERR_SUCCESS) break;
-        }
-        const float* row = rgba + (size_t)ci.start_y * (size_t)w * 4;
+        rv = have_pipeline ? exr_encoding_update(ctx, part, &ci, &enc) : exr_encoding_initialize(ctx, part, &ci, &enc);
+        if (rv != EXR_ERR_SUCCESS) break;
+        have_pipeline = 1;
         for (int c = 0; c < enc.channel_count; ++c) {
             exr_coding_channel_info_t* ch = &enc.channels[c];
-            int slot = rgba_slot(ch->channel_name);
-            if (slot < 0) {
+            int k = name_index(job->names, job->n, ch->channel_name);
+            if (k < 0) {
                 rv = EXR_ERR_INVALID_ARGUMENT;
                 break;
             }
-            ch->encode_from_ptr = (const uint8_t*)(row + slot);
-            ch->user_pixel_stride = (int32_t)(4 * sizeof(float));
-            ch->user_line_stride = (int32_t)((size_t)w * 4 * sizeof(float));
+            ch->encode_from_ptr = (const uint8_t*)(job->planes[k] + (size_t)ci.start_y * (size_t)w);
+            ch->user_pixel_stride = (int32_t)sizeof(float);
+            ch->user_line_stride = (int32_t)((size_t)w * sizeof(float));
             ch->user_bytes_per_element = (int16_t)sizeof(float);
             ch->user_data_type = (uint16_t)EXR_PIXEL_FLOAT;
         }
+        if (rv == EXR_ERR_SUCCESS && y == 0) rv = exr_encoding_choose_default_routines(ctx, part, &enc);
         if (rv != EXR_ERR_SUCCESS) break;
-        if (y == 0) {
-            rv = exr_encoding_choose_default_routines(ctx, part, &enc);
-            if (rv != EXR_ERR_SUCCESS) break;
-        }
         *stage = "compressing and writing a scanline chunk";
         rv = exr_encoding_run(ctx, part, &enc);
     }
@@ -223,8 +228,7 @@ static exr_result_t write_chunks(exr_context_t ctx, int part, int w, int h, cons
     return rv;
 }
 
-static exr_result_t write_exr_stream(const char* path, int fd, int w, int h, const float* rgba,
-                                     const char** stage)
+static exr_result_t write_exr_stream(const char* path, int fd, const write_job* job, const char** stage)
 {
     fd_stream stream = {fd, -1};
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
@@ -236,20 +240,23 @@ static exr_result_t write_exr_stream(const char* path, int fd, int w, int h, con
     int part = 0;
     *stage = "starting the file";
     exr_result_t rv = exr_start_write(&ctx, path, EXR_WRITE_FILE_DIRECTLY, &init);
+    int long_names = 0;
+    for (int c = 0; c < job->n; ++c)
+        if (strlen(job->names[c]) > EXR_SHORT_NAME_MAX) long_names = 1;
+    if (rv == EXR_ERR_SUCCESS && long_names) rv = exr_set_longname_support(ctx, 1);
     if (rv == EXR_ERR_SUCCESS) {
         *stage = "defining the header";
         rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part);
     }
     if (rv == EXR_ERR_SUCCESS)
-        rv = exr_initialize_required_attr_simple(ctx, part, w, h, EXR_COMPRESSION_ZIP);
-    static const char* const names[4] = {"R", "G", "B", "A"};
-    for (int c = 0; c < 4 && rv == EXR_ERR_SUCCESS; ++c)
-        rv = exr_add_channel(ctx, part, names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+        rv = exr_initialize_required_attr_simple(ctx, part, job->width, job->height, EXR_COMPRESSION_ZIP);
+    for (int c = 0; c < job->n && rv == EXR_ERR_SUCCESS; ++c)
+        rv = exr_add_channel(ctx, part, job->names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
     if (rv == EXR_ERR_SUCCESS) {
         *stage = "writing the header";
         rv = exr_write_header(ctx);
     }
-    if (rv == EXR_ERR_SUCCESS) rv = write_chunks(ctx, part, w, h, rgba, stage);
+    if (rv == EXR_ERR_SUCCESS) rv = write_chunks(ctx, part, job, stage);
     if (ctx) {
         const char* before = *stage;
         *stage = "finishing the file";
@@ -262,17 +269,39 @@ static exr_result_t write_exr_stream(const char* path, int fd, int w, int h, con
     return rv;
 }
 
-veil_result veil_write_exr(const char* path, int width, int height, const float* rgba, veil_error* err)
+static veil_result check_channels(const char* path, int n, const char* const* names, const float* const* planes,
+                                  veil_error* err)
 {
-    if (!path || !*path) return veil_fail(err, VEIL_ERR_INVALID, "veil_write_exr: no output path given");
-    if (width <= 0 || height <= 0)
-        return veil_fail(err, VEIL_ERR_INVALID, "%s: invalid image size %dx%d (width and height must be positive)",
-                         path, width, height);
-    size_t bytes = 0;
-    if (!veil_mul_sizes((size_t)width, (size_t)height, 4, sizeof(float), &bytes) ||
-        (size_t)width > (size_t)INT32_MAX / (4 * sizeof(float)))
-        return veil_fail(err, VEIL_ERR_INVALID, "%s: image size %dx%d is too large", path, width, height);
-    if (!rgba) return veil_fail(err, VEIL_ERR_INVALID, "%s: no pixel data given", path);
+    if (n < 1 || n > EXR_MAX_CHANNELS)
+        return veil_fail(err, VEIL_ERR_INVALID, "%s: %d channels given; an EXR needs 1 to %d", path, n,
+                         EXR_MAX_CHANNELS);
+    if (!names || !planes)
+        return veil_fail(err, VEIL_ERR_INVALID, "%s: no channel %s given", path, names ? "planes" : "names");
+    for (int c = 0; c < n; ++c) {
+        if (!names[c] || !names[c][0])
+            return veil_fail(err, VEIL_ERR_INVALID, "%s: channel %d of %d has no name", path, c + 1, n);
+        const size_t len = strlen(names[c]);
+        if (len > EXR_LONG_NAME_MAX)
+            return veil_fail(err, VEIL_ERR_INVALID,
+                             "%s: channel %d's name is %zu characters long (OpenEXR allows %d): \"%.40s...\"", path,
+                             c + 1, len, EXR_LONG_NAME_MAX, names[c]);
+        const int first = name_index(names, c, names[c]);
+        if (first >= 0)
+            return veil_fail(err, VEIL_ERR_INVALID, "%s: channel name \"%s\" is given twice (channels %d and %d)",
+                             path, names[c], first + 1, c + 1);
+        if (!planes[c])
+            return veil_fail(err, VEIL_ERR_INVALID, "%s: no pixel data given for channel \"%s\"", path, names[c]);
+    }
+    return VEIL_OK;
+}
+
+veil_result veil_write_exr_planes(const char* path, int width, int height, int n, const char* const* names,
+                                  const float* const* planes, veil_error* err)
+{
+    if (!path || !*path) return veil_fail(err, VEIL_ERR_INVALID, "veil_write_exr_planes: no output path given");
+    veil_result result = check_size(path, width, height, 1, err);
+    if (result == VEIL_OK) result = check_channels(path, n, names, planes, err);
+    if (result != VEIL_OK) return result;
 
     char* tmp = NULL;
     int fd = veil_open_temp_beside(path, &tmp);
@@ -286,13 +315,13 @@ veil_result veil_write_exr(const char* path, int width, int height, const float*
     exr_msgs* saved = tls_msgs;
     tls_msgs = &msgs;
     const char* stage = "";
-    exr_result_t rv = write_exr_stream(path, fd, width, height, rgba, &stage);
+    const write_job job = {width, height, n, names, planes};
+    exr_result_t rv = write_exr_stream(path, fd, &job, &stage);
     tls_msgs = saved;
 
     int close_errno = 0;
     if (close(fd) != 0) close_errno = errno;
 
-    veil_result result = VEIL_OK;
     if (rv != EXR_ERR_SUCCESS) {
         result = veil_fail(err, VEIL_ERR_IO, "%s: cannot write OpenEXR file (%s): %s [%s]", path, stage,
                            exr_reason(&msgs, rv), exr_get_error_code_as_string(rv));
@@ -306,6 +335,28 @@ veil_result veil_write_exr(const char* path, int width, int height, const float*
     if (result != VEIL_OK) unlink(tmp);
     free(tmp);
     return result;
+}
+
+veil_result veil_write_exr(const char* path, int width, int height, const float* rgba, veil_error* err)
+{
+    if (!path || !*path) return veil_fail(err, VEIL_ERR_INVALID, "veil_write_exr: no output path given");
+    veil_result r = check_size(path, width, height, 4, err);
+    if (r != VEIL_OK) return r;
+    if (!rgba) return veil_fail(err, VEIL_ERR_INVALID, "%s: no pixel data given", path);
+
+    const size_t count = (size_t)width * (size_t)height;
+    float* planar = malloc(count * 4 * sizeof *planar);
+    if (!planar)
+        return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory for a %dx%d image", path, width, height);
+    const float* planes[4];
+    for (int c = 0; c < 4; ++c) {
+        float* dst = planar + (size_t)c * count;
+        for (size_t i = 0; i < count; ++i) dst[i] = rgba[i * 4 + (size_t)c];
+        planes[c] = dst;
+    }
+    r = veil_write_exr_planes(path, width, height, 4, rgba_names, planes, err);
+    free(planar);
+    return r;
 }
 
 /* ------------------------------------------------------------------------ */
@@ -381,8 +432,21 @@ static exr_result_t unpack_to_float(exr_decode_pipeline_t* d)
     return EXR_ERR_SUCCESS;
 }
 
+#define EXR_READ_MAX 4 /* channels one read may want */
+
+/* What a reader wants: named channels, interleaved in this order. */
+typedef struct read_request {
+    int n;
+    const char* const* names;
+    int optional;             /* index of the one that may be absent (read as 1), or -1 */
+    veil_result missing_code; /* when another one is absent */
+    const char* missing_note; /* said after the missing names */
+} read_request;
+
 typedef struct read_target {
-    float* pixels; /* W*H*4 */
+    int n;
+    const char* const* names;
+    float* pixels; /* width*height*n */
     int width, height;
     int min_x, min_y; /* data window origin */
 } read_target;
@@ -396,22 +460,17 @@ static exr_result_t decode_chunk(exr_const_context_t ctx, const exr_chunk_info_t
     if (x0 < 0 || y0 < 0 || ci->width <= 0 || ci->height <= 0 || (int64_t)x0 + ci->width > t->width ||
         (int64_t)y0 + ci->height > t->height)
         return EXR_ERR_INCORRECT_CHUNK;
-    if (!*pipeline_ready) {
-        rv = exr_decoding_initialize(ctx, 0, ci, dec);
-        if (rv != EXR_ERR_SUCCESS) return rv;
-        *pipeline_ready = 1;
-    } else {
-        rv = exr_decoding_update(ctx, 0, ci, dec);
-        if (rv != EXR_ERR_SUCCESS) return rv;
-    }
-    float* base = t->pixels + ((size_t)y0 * (size_t)t->width + (size_t)x0) * 4;
+    rv = *pipeline_ready ? exr_decoding_update(ctx, 0, ci, dec) : exr_decoding_initialize(ctx, 0, ci, dec);
+    if (rv != EXR_ERR_SUCCESS) return rv;
+    *pipeline_ready = 1;
+    float* base = t->pixels + ((size_t)y0 * (size_t)t->width + (size_t)x0) * (size_t)t->n;
     for (int c = 0; c < dec->channel_count; ++c) {
         exr_coding_channel_info_t* ch = &dec->channels[c];
-        int slot = rgba_slot(ch->channel_name);
-        if (slot >= 0 && ch->x_samples == 1 && ch->y_samples == 1) {
-            ch->decode_to_ptr = (uint8_t*)(base + slot);
-            ch->user_pixel_stride = (int32_t)(4 * sizeof(float));
-            ch->user_line_stride = (int32_t)((size_t)t->width * 4 * sizeof(float));
+        int k = name_index(t->names, t->n, ch->channel_name);
+        if (k >= 0 && ch->x_samples == 1 && ch->y_samples == 1) {
+            ch->decode_to_ptr = (uint8_t*)(base + k);
+            ch->user_pixel_stride = (int32_t)((size_t)t->n * sizeof(float));
+            ch->user_line_stride = (int32_t)((size_t)t->width * (size_t)t->n * sizeof(float));
             ch->user_bytes_per_element = (int16_t)sizeof(float);
             ch->user_data_type = (uint16_t)EXR_PIXEL_FLOAT;
         } else {
@@ -483,18 +542,20 @@ static veil_result read_pixels(exr_const_context_t ctx, const char* path, exr_st
     return VEIL_OK;
 }
 
-static const char* pixel_type_name(exr_pixel_type_t t)
+/* Appends "item" (quoted) to a ", "-separated list in buf; a list that
+ * does not fit ends in "...". */
+static void list_append(char* buf, size_t cap, const char* item)
 {
-    switch (t) {
-    case EXR_PIXEL_UINT: return "uint";
-    case EXR_PIXEL_HALF: return "half";
-    case EXR_PIXEL_FLOAT: return "float";
-    default: return "unknown";
-    }
+    size_t len = strlen(buf);
+    if (len >= 3 && strcmp(buf + len - 3, "...") == 0) return;
+    int n = snprintf(buf + len, cap - len, "%s\"%s\"", len ? ", " : "", item);
+    if (n >= 0 && (size_t)n < cap - len) return;
+    size_t at = len + 6 <= cap ? len : cap - 6;
+    snprintf(buf + at, cap - at, "%s...", at ? ", " : "");
 }
 
-static veil_result read_image(exr_const_context_t ctx, const char* path, int* width, int* height, float** rgba,
-                              exr_msgs* msgs, veil_error* err)
+static veil_result read_channels(exr_const_context_t ctx, const char* path, const read_request* req, int* width,
+                                 int* height, float** out, exr_msgs* msgs, veil_error* err)
 {
     int parts = 0;
     exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
@@ -514,41 +575,52 @@ static veil_result read_image(exr_const_context_t ctx, const char* path, int* wi
         return veil_fail(err, VEIL_ERR_IO, "%s: deep OpenEXR images are not supported (only scanline or tiled)",
                          path);
 
+    const int n = req->n;
     const int64_t w = (int64_t)dw.max.x - dw.min.x + 1;
     const int64_t h = (int64_t)dw.max.y - dw.min.y + 1;
     if (w <= 0 || h <= 0 || w > INT_MAX || h > INT_MAX)
         return veil_fail(err, VEIL_ERR_IO, "%s: invalid OpenEXR data window (%d, %d)-(%d, %d)", path, dw.min.x,
                          dw.min.y, dw.max.x, dw.max.y);
     size_t bytes = 0;
-    if (!veil_mul_sizes((size_t)w, (size_t)h, 4, sizeof(float), &bytes) ||
-        (uint64_t)w > (uint64_t)INT32_MAX / (4 * sizeof(float)))
+    if (!veil_mul_sizes((size_t)w, (size_t)h, (size_t)n, sizeof(float), &bytes) ||
+        (uint64_t)w > (uint64_t)INT32_MAX / ((size_t)n * sizeof(float)))
         return veil_fail(err, VEIL_ERR_IO, "%s: OpenEXR image %" PRId64 "x%" PRId64 " is too large", path, w, h);
 
-    int found[4] = {0, 0, 0, 0};
+    int found[EXR_READ_MAX] = {0};
     for (int c = 0; c < chans->num_channels; ++c) {
         const exr_attr_chlist_entry_t* e = &chans->entries[c];
-        int slot = rgba_slot(e->name.str);
-        if (slot < 0) continue; /* other channels are ignored */
+        int k = name_index(req->names, n, e->name.str);
+        if (k < 0) continue; /* other channels are ignored */
         if (e->pixel_type != EXR_PIXEL_HALF && e->pixel_type != EXR_PIXEL_FLOAT)
             return veil_fail(err, VEIL_ERR_IO, "%s: channel %s has pixel type %s; only half and float are supported",
-                             path, e->name.str, pixel_type_name(e->pixel_type));
+                             path, e->name.str, e->pixel_type == EXR_PIXEL_UINT ? "uint" : "unknown");
         if (e->x_sampling != 1 || e->y_sampling != 1)
             return veil_fail(err, VEIL_ERR_IO, "%s: channel %s is subsampled (%d, %d); that is not supported", path,
                              e->name.str, e->x_sampling, e->y_sampling);
-        found[slot] = 1;
+        found[k] = 1;
     }
-    if (!found[0] || !found[1] || !found[2])
-        return veil_fail(err, VEIL_ERR_IO, "%s: OpenEXR image lacks channel%s%s%s%s (R, G and B are required)", path,
-                         (!found[0] + !found[1] + !found[2]) > 1 ? "s" : "", found[0] ? "" : " R",
-                         found[1] ? "" : " G", found[2] ? "" : " B");
+    char missing[512] = "";
+    int nmissing = 0;
+    for (int k = 0; k < n; ++k)
+        if (!found[k] && k != req->optional) {
+            list_append(missing, sizeof missing, req->names[k]);
+            ++nmissing;
+        }
+    if (nmissing) {
+        char have[1024] = "";
+        for (int c = 0; c < chans->num_channels; ++c) list_append(have, sizeof have, chans->entries[c].name.str);
+        return veil_fail(err, req->missing_code, "%s: OpenEXR image has no channel%s %s%s; its channels are %s", path,
+                         nmissing > 1 ? "s" : "", missing, req->missing_note, have[0] ? have : "none");
+    }
 
     float* pixels = calloc(bytes / sizeof(float), sizeof(float));
     if (!pixels)
         return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory for a %" PRId64 "x%" PRId64 " image", path, w, h);
-    if (!found[3])
-        for (size_t i = 0, n = (size_t)w * (size_t)h; i < n; ++i) pixels[i * 4 + 3] = 1.0f;
+    if (req->optional >= 0 && !found[req->optional])
+        for (size_t i = 0, count = (size_t)w * (size_t)h; i < count; ++i)
+            pixels[i * (size_t)n + (size_t)req->optional] = 1.0f;
 
-    read_target t = {pixels, (int)w, (int)h, dw.min.x, dw.min.y};
+    read_target t = {n, req->names, pixels, (int)w, (int)h, dw.min.x, dw.min.y};
     veil_result r = read_pixels(ctx, path, storage, &t, msgs, err);
     if (r != VEIL_OK) {
         free(pixels);
@@ -556,29 +628,32 @@ static veil_result read_image(exr_const_context_t ctx, const char* path, int* wi
     }
     *width = (int)w;
     *height = (int)h;
-    *rgba = pixels;
+    *out = pixels;
     return VEIL_OK;
 }
 
-veil_result veil_read_exr(const char* path, int* width, int* height, float** rgba, veil_error* err)
+/* Opens `path` and reads the channels `req` asks for; `fn` names the
+ * public function in messages about its arguments. */
+static veil_result read_exr_file(const char* fn, const char* path, const read_request* req, int* width, int* height,
+                                 float** out, veil_error* err)
 {
-    if (rgba) *rgba = NULL;
+    if (out) *out = NULL;
     if (width) *width = 0;
     if (height) *height = 0;
-    if (!path || !*path) return veil_fail(err, VEIL_ERR_INVALID, "veil_read_exr: no input path given");
-    if (!width || !height || !rgba)
-        return veil_fail(err, VEIL_ERR_INVALID, "%s: veil_read_exr: missing output argument", path);
+    if (!path || !*path) return veil_fail(err, VEIL_ERR_INVALID, "%s: no input path given", fn);
+    if (!width || !height || !out)
+        return veil_fail(err, VEIL_ERR_INVALID, "%s: %s: missing output argument", path, fn);
+    for (int k = 0; k < req->n; ++k)
+        if (!req->names[k] || !req->names[k][0])
+            return veil_fail(err, VEIL_ERR_INVALID, "%s: %s: no channel name given", path, fn);
 
     int fd = open(path, O_RDONLY | O_CLOEXEC);
     if (fd < 0) return veil_fail(err, VEIL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
     struct stat st;
-    if (fstat(fd, &st) != 0) {
-        int e = errno;
+    const int stat_errno = fstat(fd, &st) != 0 ? errno : 0;
+    if (stat_errno || !S_ISREG(st.st_mode)) {
         close(fd);
-        return veil_fail(err, VEIL_ERR_IO, "%s: cannot stat: %s", path, strerror(e));
-    }
-    if (!S_ISREG(st.st_mode)) {
-        close(fd);
+        if (stat_errno) return veil_fail(err, VEIL_ERR_IO, "%s: cannot stat: %s", path, strerror(stat_errno));
         return veil_fail(err, VEIL_ERR_IO, "%s: not a regular file", path);
     }
 
@@ -602,10 +677,24 @@ veil_result veil_read_exr(const char* path, int* width, int* height, float** rgb
         r = veil_fail(err, VEIL_ERR_IO, "%s: not a readable OpenEXR file: %s [%s]", path, exr_reason(&msgs, rv),
                       exr_get_error_code_as_string(rv));
     } else {
-        r = read_image(ctx, path, width, height, rgba, &msgs, err);
+        r = read_channels(ctx, path, req, width, height, out, &msgs, err);
     }
     if (ctx) exr_finish(&ctx);
     tls_msgs = saved;
     close(fd);
     return r;
+}
+
+veil_result veil_read_exr(const char* path, int* width, int* height, float** rgba, veil_error* err)
+{
+    const read_request req = {4, rgba_names, 3, VEIL_ERR_IO, " (R, G and B are required)"};
+    return read_exr_file("veil_read_exr", path, &req, width, height, rgba, err);
+}
+
+veil_result veil_read_exr_channel(const char* path, const char* name, int* width, int* height, float** plane,
+                                  veil_error* err)
+{
+    const char* const names[1] = {name};
+    const read_request req = {1, names, -1, VEIL_ERR_INVALID, ""};
+    return read_exr_file("veil_read_exr_channel", path, &req, width, height, plane, err);
 }

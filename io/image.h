@@ -15,6 +15,21 @@
 veil_result veil_write_exr(const char* path, int width, int height,
                            const float* rgba, veil_error* err);
 
+/* EXR with n named float channels (e.g. "R", "G", "B", "A", "stderr.R"),
+ * each a width*height plane, top row first, ZIP compression. n is 1 to 64;
+ * names must be non-empty, distinct and at most 255 characters (over 31
+ * sets OpenEXR's long-names flag); VEIL_ERR_INVALID otherwise. OpenEXR
+ * stores channels sorted by name. */
+veil_result veil_write_exr_planes(const char* path, int width, int height, int n, const char* const* names,
+                                  const float* const* planes, veil_error* err);
+
+/* Reads one named channel (half or float, case-sensitive name) of an EXR,
+ * scanline or tiled as veil_read_exr, as float into a newly malloc'd
+ * width*height plane (free() it); VEIL_ERR_INVALID naming the file and
+ * channel, and listing the channels it has, when it has no such channel. */
+veil_result veil_read_exr_channel(const char* path, const char* name, int* width, int* height, float** plane,
+                                  veil_error* err);
+
 /* Reads an EXR's R, G, B, A channels (A = 1 when absent) as float into a
  * newly malloc'd buffer *rgba (free() it). Any scanline or tiled EXR that
  * OpenEXRCore decodes with half or float channels. */
@@ -25,6 +40,12 @@ veil_result veil_read_exr(const char* path, int* width, int* height,
  * 2^exposure, tone-mapped by veil_tonemap(), then sRGB-encoded. */
 veil_result veil_write_png(const char* path, int width, int height,
                            const float* rgba, float exposure, veil_error* err);
+
+/* 8-bit PNG, RGB (no alpha), from width*height*3 bytes already encoded
+ * (sRGB, row-major, top row first), stored as given; the file carries an
+ * sRGB chunk. For images made of colours rather than light (a heatmap). */
+veil_result veil_write_png_rgb8(const char* path, int width, int height,
+                                const unsigned char* rgb, veil_error* err);
 
 /* The preview's tone curve on one linear channel value: x / (1 + x)
  * (Reinhard) applied to x >= 0; NaN and negatives map to 0. */

@@ -4,6 +4,8 @@
  * round(v * 255). RGB only; the file carries an sRGB chunk (with the matching
  * gAMA and cHRM for older readers). Written to a temporary file beside the
  * target and renamed into place only when everything succeeded.
+ * veil_write_png_rgb8 writes bytes that are already encoded (a heatmap's
+ * colours) the same way.
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -182,5 +184,87 @@ veil_result veil_write_png(const char* path, int width, int height, const float*
     if (result != VEIL_OK) unlink(tmp);
     free(tmp);
     free(row);
+    return result;
+}
+
+/* As encode_png, for rows of bytes stored as given. Returns 1 on success. */
+static int encode_png_rgb8(FILE* fp, int width, int height, const unsigned char* rgb, png_msg* msg)
+{
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, msg, on_png_error, on_png_warning);
+    if (!png) {
+        snprintf(msg->text, sizeof msg->text, "cannot create the libpng write structure");
+        return 0;
+    }
+    png_infop info = png_create_info_struct(png);
+    if (!info) {
+        png_destroy_write_struct(&png, NULL);
+        snprintf(msg->text, sizeof msg->text, "cannot create the libpng info structure");
+        return 0;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        return 0;
+    }
+    png_set_write_fn(png, fp, write_data, flush_data);
+    png_set_user_limits(png, 0x7fffffffu, 0x7fffffffu);
+    png_set_IHDR(png, info, (png_uint_32)width, (png_uint_32)height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_write_info(png, info);
+    for (int y = 0; y < height; ++y) png_write_row(png, rgb + (size_t)y * (size_t)width * 3);
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    return 1;
+}
+
+veil_result veil_write_png_rgb8(const char* path, int width, int height, const unsigned char* rgb, veil_error* err)
+{
+    if (!path || !*path) return veil_fail(err, VEIL_ERR_INVALID, "veil_write_png_rgb8: no output path given");
+    if (width <= 0 || height <= 0)
+        return veil_fail(err, VEIL_ERR_INVALID, "%s: invalid image size %dx%d (width and height must be positive)",
+                         path, width, height);
+    size_t bytes = 0;
+    if (!veil_mul_sizes((size_t)width, (size_t)height, 3, 1, &bytes))
+        return veil_fail(err, VEIL_ERR_INVALID, "%s: image size %dx%d is too large", path, width, height);
+    if (!rgb) return veil_fail(err, VEIL_ERR_INVALID, "%s: no pixel data given", path);
+
+    char* tmp = NULL;
+    int fd = veil_open_temp_beside(path, &tmp);
+    if (fd < 0) {
+        int e = errno;
+        if (e == 0)
+            return veil_fail(err, VEIL_ERR_IO, "%s: exists and is not a regular file; not replacing it", path);
+        return veil_fail(err, VEIL_ERR_IO, "%s: cannot create a temporary file beside it: %s", path, strerror(e));
+    }
+    FILE* fp = fdopen(fd, "wb");
+    if (!fp) {
+        int e = errno;
+        close(fd);
+        unlink(tmp);
+        free(tmp);
+        return veil_fail(err, VEIL_ERR_IO, "%s: cannot open a stream on the temporary file: %s", path, strerror(e));
+    }
+
+    png_msg msg = {{0}};
+    veil_result result = VEIL_OK;
+    if (!encode_png_rgb8(fp, width, height, rgb, &msg)) {
+        fclose(fp);
+        result = veil_fail(err, VEIL_ERR_IO, "%s: cannot write PNG: %s", path, msg.text);
+    } else {
+        int failed = fflush(fp) != 0 || ferror(fp);
+        int e = errno;
+        if (fclose(fp) != 0 && !failed) {
+            failed = 1;
+            e = errno;
+        }
+        if (failed)
+            result = veil_fail(err, VEIL_ERR_IO, "%s: cannot write PNG: writing %s failed: %s", path, tmp,
+                               strerror(e));
+        else if (rename(tmp, path) != 0)
+            result = veil_fail(err, VEIL_ERR_IO, "%s: cannot move the temporary file %s into place: %s", path, tmp,
+                               strerror(errno));
+    }
+    if (result != VEIL_OK) unlink(tmp);
+    free(tmp);
     return result;
 }

@@ -1,15 +1,14 @@
-#define _POSIX_C_SOURCE 200809L /* stat: st_mtim */
 #include "renderer.h"
 
 #include <math.h>
-#include <sys/stat.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/hash.h"
 #include "../propagate/opv_gpu.h"
 #include "../io/vdb.h"
 #include "../volume/inject_gpu.h"
-#include "../volume/vdb_volume.h"
+#include "../volume/scene_volume.h"
 #include "camera.h"
 #include "gl_util.h"
 
@@ -27,18 +26,6 @@ struct veil_renderer {
     uint64_t opv_key[VEIL_MAX_OPV_TEXTURES];
     GLuint opv[VEIL_MAX_OPV_TEXTURES];
 };
-
-/* ---- content keys (FNV-1a, 64 bit) ------------------------------------- */
-
-#define VEIL__FNV_OFFSET 0xcbf29ce484222325ull
-#define VEIL__FNV_PRIME 0x100000001b3ull
-
-static uint64_t hash_bytes(uint64_t h, const void* data, size_t n)
-{
-    const unsigned char* p = data;
-    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * VEIL__FNV_PRIME;
-    return h;
-}
 
 /* ---- lifetime ---------------------------------------------------------- */
 
@@ -197,110 +184,44 @@ static veil_result build_occupancy(veil_renderer* r, veil_error* err)
     return veil_gl_check("occupancy bricks (render/shaders/occupancy.comp)", err);
 }
 
-/* The scene's OpenVDB grids, opened; count of them in *n. */
-static veil_result open_vdbs(const veil_scene* s, veil_vdb** vdbs, const veil_source** srcs, int* n, uint64_t* key,
-                             veil_error* err)
-{
-    *n = 0;
-    for (size_t i = 0; i < s->medium.source_count; ++i) {
-        const veil_source* src = &s->medium.sources[i];
-        if (src->type != VEIL_SOURCE_VDB) continue;
-        if (*n == VEIL_MAX_VDB_SOURCES)
-            return veil_fail(err, VEIL_ERR_LIMIT, "medium.sources[%zu]: at most %d vdb sources", i,
-                             VEIL_MAX_VDB_SOURCES);
-        char chosen[256];
-        veil_result r = veil_vdb_open(src->vdb.file, src->vdb.grid, src->vdb.level_set_to_fog, &vdbs[*n], chosen,
-                                      sizeof chosen, err);
-        if (r != VEIL_OK) {
-            veil_error inner = *err;
-            return veil_fail(err, r, "medium.sources[%zu]: %.1900s", i, inner.msg);
-        }
-        srcs[(*n)++] = src;
-        /* the file's identity, not its bytes: path, size and modification time */
-        struct stat sb;
-        memset(&sb, 0, sizeof sb);
-        stat(src->vdb.file, &sb);
-        *key = hash_bytes(*key, src->vdb.file, strlen(src->vdb.file));
-        *key = hash_bytes(*key, chosen, strlen(chosen));
-        *key = hash_bytes(*key, &sb.st_size, sizeof sb.st_size);
-        *key = hash_bytes(*key, &sb.st_mtim, sizeof sb.st_mtim);
-        *key = hash_bytes(*key, &src->vdb.density_scale, sizeof src->vdb.density_scale);
-        *key = hash_bytes(*key, &src->vdb.level_set_to_fog, sizeof src->vdb.level_set_to_fog);
-    }
-    return VEIL_OK;
-}
-
-/* Grows [lo, hi] (valid when *any) by the box [a, b]. */
-static void grow(float lo[3], float hi[3], int* any, const float a[3], const float b[3])
-{
-    for (int k = 0; k < 3; ++k) {
-        lo[k] = *any ? fminf(lo[k], a[k]) : a[k];
-        hi[k] = *any ? fmaxf(hi[k], b[k]) : b[k];
-    }
-    *any = 1;
-}
-
 /* The EV from every voxelised source: OpenVDB grids resampled on the CPU
  * into the volume, then the RBF particles added on the GPU. */
 static veil_result inject_scene(veil_renderer* r, const veil_scene* s, veil_render_stats* st, veil_error* err)
 {
-    veil_particle* parts = NULL;
-    size_t n = 0;
-    veil_vdb* vdbs[VEIL_MAX_VDB_SOURCES] = {0};
-    const veil_source* vsrc[VEIL_MAX_VDB_SOURCES];
-    int n_vdb = 0;
-    uint64_t key = hash_bytes(VEIL__FNV_OFFSET, &s->medium.max_resolution, sizeof s->medium.max_resolution);
-    veil_result res = veil_scene_particles(s, &parts, &n, err);
-    if (res == VEIL_OK) res = open_vdbs(s, vdbs, vsrc, &n_vdb, &key, err);
-    if (res == VEIL_OK) key = hash_bytes(key, parts, n * sizeof *parts);
-    float lo[3], hi[3], a[3], b[3];
-    int any = 0;
-    if (res != VEIL_OK) {
-    } else if (r->ev_key == key) {
+    veil_scene_volume v;
+    veil_result res = veil_scene_volume_open(s, &v, err);
+    if (res != VEIL_OK) return res;
+    st->vdb_voxels = v.vdb_voxels;
+    if (r->ev_key == v.key) {
         st->inject_cached = 1;
+        st->vdb_voxels = 0;
+    } else if (!v.has_volume) {
+        drop_volume(r);
+        r->ev_key = v.key; /* an empty medium, remembered as such */
     } else {
-        if (veil_rbf_bounds(parts, n, a, b)) grow(lo, hi, &any, a, b);
-        for (int i = 0; i < n_vdb && res == VEIL_OK; ++i) {
-            int ilo[3], ihi[3];
-            size_t active = 0;
-            res = veil_vdb_index_bbox(vdbs[i], ilo, ihi, &active);
-            if (res == VEIL_OK && active > 0 && vsrc[i]->vdb.density_scale > 0.0f) {
-                res = veil_vdb_world_support(vdbs[i], a, b, err);
-                if (res == VEIL_OK) grow(lo, hi, &any, a, b);
-            }
-            st->vdb_voxels += active;
-        }
-        veil_grid g;
+        const veil_grid* g = &v.grid;
         veil_rbf_bins bins = {0};
         float* density = NULL;
-        if (res != VEIL_OK || !any) {
-            drop_volume(r);
-            r->ev_key = res == VEIL_OK ? key : 0; /* an empty medium, remembered as such */
-        } else {
-            res = veil_grid_fit(lo, hi, s->medium.max_resolution, &g, err);
-            if (res == VEIL_OK) res = make_ev(r, &g, key, (int)s->light_count, err);
-            if (res == VEIL_OK && n_vdb > 0) {
-                density = calloc(veil_grid_voxels(&g), sizeof(float));
-                if (!density) res = veil_fail(err, VEIL_ERR_OOM, "out of memory for a %zu-voxel volume",
-                                              veil_grid_voxels(&g));
-                for (int i = 0; i < n_vdb && res == VEIL_OK; ++i)
-                    res = veil_vdb_to_grid(vdbs[i], vsrc[i]->vdb.density_scale, &g, density, err);
-                if (res == VEIL_OK) {
-                    glTextureSubImage3D(r->ev, 0, 0, 0, 0, g.dims[0], g.dims[1], g.dims[2], GL_RED, GL_FLOAT, density);
-                    res = veil_gl_check("uploading the resampled grids", err);
-                }
+        res = make_ev(r, g, v.key, (int)s->light_count, err);
+        if (res == VEIL_OK && v.vdb_count > 0) {
+            density = calloc(veil_grid_voxels(g), sizeof(float));
+            if (!density) res = veil_fail(err, VEIL_ERR_OOM, "out of memory for a %zu-voxel volume", veil_grid_voxels(g));
+            if (res == VEIL_OK) res = veil_scene_volume_add_vdbs(&v, density, err);
+            if (res == VEIL_OK) {
+                glTextureSubImage3D(r->ev, 0, 0, 0, 0, g->dims[0], g->dims[1], g->dims[2], GL_RED, GL_FLOAT, density);
+                res = veil_gl_check("uploading the resampled grids", err);
             }
-            if (res == VEIL_OK && n > 0) res = veil_rbf_bin(&g, parts, n, &bins, err);
-            if (res == VEIL_OK && n > 0) res = veil_inject_rbf_gpu(r->inject, &g, &bins, r->ev, err);
-            if (res == VEIL_OK) res = build_occupancy(r, err);
-            if (res != VEIL_OK) drop_volume(r);
         }
+        size_t n = v.particle_count;
+        if (res == VEIL_OK && n > 0) res = veil_rbf_bin(g, v.particles, n, &bins, err);
+        if (res == VEIL_OK && n > 0) res = veil_inject_rbf_gpu(r->inject, g, &bins, r->ev, err);
+        if (res == VEIL_OK) res = build_occupancy(r, err);
+        if (res != VEIL_OK) drop_volume(r);
         free(density);
         veil_rbf_bins_free(&bins);
         r->particles = n;
     }
-    for (int i = 0; i < n_vdb; ++i) veil_vdb_close(vdbs[i]);
-    free(parts);
+    veil_scene_volume_close(&v);
     return res;
 }
 
@@ -317,10 +238,10 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
     for (int t = 0; 4 * t < n && res == VEIL_OK; ++t) {
         int count = n - 4 * t < 4 ? n - 4 * t : 4;
         veil_opv_light ol[4];
-        uint64_t key = hash_bytes(r->ev_key, &params, sizeof params);
+        uint64_t key = veil_hash_bytes(r->ev_key, &params, sizeof params);
         for (int c = 0; c < count; ++c) {
             veil_opv_light_from_world(&r->grid, &lights[4 * t + c], &ol[c]);
-            key = hash_bytes(key, &ol[c], sizeof ol[c]);
+            key = veil_hash_bytes(key, &ol[c], sizeof ol[c]);
         }
         if (r->opv[t] && r->opv_key[t] == key) {
             ++st->opv_cached;
@@ -341,8 +262,9 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
 
 static void set_march_uniforms(GLuint p, const veil_scene* s, const veil_light* lights, int n,
                                const veil_camera_basis* cam, int w, int h, const veil_grid* g, float step_voxels,
-                               uint32_t seed, int skip_empty)
+                               uint32_t seed, int skip_empty, float max_distance)
 {
+    glProgramUniform1f(p, glGetUniformLocation(p, "u_stop_t"), max_distance > 0.0f ? max_distance : 3.0e38f);
     glProgramUniform2i(p, glGetUniformLocation(p, "u_size"), w, h);
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_cam_pos"), 1, cam->pos);
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_cam_fwd"), 1, cam->fwd);
@@ -440,7 +362,7 @@ static veil_result march(veil_renderer* r, const veil_scene* s, const veil_light
         GLuint p = r->march;
         glUseProgram(p);
         set_march_uniforms(p, s, lights, n, &cam, w, h, r->has_volume ? &r->grid : NULL, step, o->seed,
-                           !o->no_skip);
+                           !o->no_skip, o->max_distance);
         glBindTextureUnit(VEIL_TEX_EV, r->ev);
         glBindTextureUnit(VEIL_TEX_OCC, r->occ);
         for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, r->opv[t]);
@@ -505,8 +427,8 @@ veil_result veil_render_density(veil_renderer* r, const veil_scene* s, const vei
     veil_render_stats st = {0};
     *rgba = NULL;
     double t0 = veil_now_ms();
-    uint64_t key = hash_bytes(VEIL__FNV_OFFSET, g, sizeof *g);
-    key = hash_bytes(key, density, veil_grid_voxels(g) * sizeof(float));
+    uint64_t key = veil_hash_bytes(VEIL_FNV_OFFSET, g, sizeof *g);
+    key = veil_hash_bytes(key, density, veil_grid_voxels(g) * sizeof(float));
     veil_result res = VEIL_OK;
     if (r->has_volume && r->ev_key == key) {
         st.inject_cached = 1;

@@ -25,6 +25,7 @@
 #include "../core/result.h"
 #include "../io/scene.h"
 #include "../propagate/opv.h"
+#include "../volume/scene_volume.h"
 #include "../volume/volume.h"
 #include "gl_context.h"
 
@@ -35,9 +36,6 @@
 /* Jacobi stops when a checked step changes no optical depth sigma_t * D by
  * more than this (unitless): well under the 8-bit resolution of a preview. */
 #define VEIL_OPV_TAU_TOLERANCE 1e-4f
-
-/* At most this many OpenVDB grids in one scene. */
-#define VEIL_MAX_VDB_SOURCES 8
 
 /* The smallest march step through fog when there is no volume (m). */
 #define VEIL_FOG_MIN_STEP 0.01f
@@ -55,6 +53,11 @@ typedef struct veil_render_opts {
     veil_opv_method method; /* 0: VEIL_OPV_DEFAULT_METHOD */
     const veil_camera* camera; /* NULL: the scene's (turntables move it) */
     int no_skip;            /* 1: march through empty bricks too (to measure what skipping saves) */
+    /* > 0: rays stop at the first step boundary at or beyond this distance
+     * from the camera (m); the steps before it are the same as without it,
+     * so alpha (1 - mean T) is the transmittance of a prefix of the same
+     * march (tests of T along rays). 0: no limit. */
+    float max_distance;
 } veil_render_opts;
 
 typedef struct veil_render_stats {

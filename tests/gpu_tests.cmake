@@ -9,3 +9,6 @@ add_test(NAME cli_end_to_end
           ${PROJECT_SOURCE_DIR}/data/scenes/demo.json)
 set_tests_properties(cli_end_to_end PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)
 veil_test(test_render_cache SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_render_cache.c LABELS gpu)
+# The marcher against closed forms (airlight, a Gaussian's erf, slanted
+# exponential fog) within step-error bounds derived in the test.
+veil_test(test_marcher_closed_forms SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_marcher_closed_forms.c LABELS "gpu;accuracy")

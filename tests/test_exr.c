@@ -1,4 +1,5 @@
-/* Tests for io/exr.c: EXR write/read, foreign inputs, failure cleanup. */
+/* Tests for io/exr.c: EXR write/read, named planes and channels, foreign
+ * inputs, failure cleanup. */
 #define _POSIX_C_SOURCE 200809L
 
 #include "check.h"
@@ -110,7 +111,7 @@ typedef struct exr_facts {
     exr_compression_t compression;
     exr_attr_box2i_t dw;
     int nchans;
-    char names[8][8];
+    char names[8][32];
     exr_pixel_type_t types[8];
 } exr_facts;
 
@@ -274,6 +275,147 @@ static void test_exr_channels(void)
     unlink(path);
 }
 
+/* Named planes: veil_write_exr_planes, veil_read_exr_channel. The names
+ * are given unsorted; the file stores them sorted. */
+static const char* const g_seven[7] = {"stderr.B", "R", "A", "stderr.R", "G", "stderr.G", "B"};
+
+static void expect_plane(const char* path, const char* name, int w, int h, const float* want)
+{
+    veil_error err = {{0}};
+    int rw = 0, rh = 0;
+    float* back = NULL;
+    veil_result r = veil_read_exr_channel(path, name, &rw, &rh, &back, &err);
+    CHECK(r == VEIL_OK && back && rw == w && rh == h, "%s: channel %s: %s, %dx%d (%s)", path, name,
+          veil_result_name(r), rw, rh, err.msg);
+    if (back && rw == w && rh == h) {
+        size_t bad = 0, n = (size_t)w * h;
+        for (size_t i = 0; i < n; ++i)
+            if (!same_bits(back[i], want[i]) && bad++ < 3)
+                fprintf(stderr, "  %s[%zu]: %.9g read back as %.9g\n", name, i, want[i], back[i]);
+        CHECK(bad == 0, "%s: channel %s: %zu of %zu values not bit-exact", path, name, bad, n);
+    }
+    free(back);
+}
+
+static void test_exr_planes(void)
+{
+    char path[256];
+    path_in(path, sizeof path, "planes.exr");
+    const int w = 9, h = 35, n = 7; /* several ZIP chunks, the last one partial */
+    const size_t count = (size_t)w * h;
+    float* store = malloc(sizeof(float) * count * n);
+    const float* planes[7];
+    for (int c = 0; c < n; ++c) {
+        float* p = store + (size_t)c * count;
+        for (size_t i = 0; i < count; ++i)
+            p[i] = i % 3 == 0 ? random_finite() : (float)(c + 1) * 1000.0f + (float)i * 0.5f;
+        planes[c] = p;
+    }
+    const uint32_t nan_bits = 0x7fc12345u;
+    store[1] = -0.0f;
+    store[2] = INFINITY;
+    memcpy(&store[count + 1], &nan_bits, sizeof nan_bits);
+
+    veil_error err = {{0}};
+    CHECK(veil_write_exr_planes(path, w, h, n, g_seven, planes, &err) == VEIL_OK, "write %s: %s", path, err.msg);
+    int temps = 0;
+    CHECK(count_entries(g_dir, &temps) == 1 && temps == 0, "after writing %s the directory should hold just it",
+          path);
+
+    /* the file as OpenEXRCore sees it, and one plane decoded by the library */
+    static const char* const sorted[7] = {"A", "B", "G", "R", "stderr.B", "stderr.G", "stderr.R"};
+    float* lib = calloc(count, sizeof(float));
+    exr_facts f = core_inspect(path, "stderr.G", lib);
+    int header_ok = f.ok && f.nchans == 7 && f.storage == EXR_STORAGE_SCANLINE && f.compression == EXR_COMPRESSION_ZIP;
+    for (int c = 0; c < 7 && header_ok; ++c)
+        header_ok = strcmp(f.names[c], sorted[c]) == 0 && f.types[c] == EXR_PIXEL_FLOAT;
+    CHECK(header_ok, "%s: %d channels, first %s, last %s", path, f.nchans, f.names[0], f.names[6]);
+    CHECK(f.ok && memcmp(lib, planes[5], count * sizeof(float)) == 0, "the file's stderr.G does not hold stderr.G");
+    free(lib);
+
+    for (int c = 0; c < n; ++c) expect_plane(path, g_seven[c], w, h, planes[c]);
+
+    /* R, G, B, A through veil_read_exr */
+    int rw = 0, rh = 0;
+    float* back = NULL;
+    CHECK(veil_read_exr(path, &rw, &rh, &back, &err) == VEIL_OK && rw == w && rh == h, "read %s: %s", path, err.msg);
+    if (back && rw == w && rh == h) {
+        const float* rgba[4] = {planes[1], planes[4], planes[6], planes[2]};
+        size_t bad = 0;
+        for (size_t i = 0; i < count; ++i)
+            for (int c = 0; c < 4; ++c)
+                if (!same_bits(back[i * 4 + (size_t)c], rgba[c][i])) ++bad;
+        CHECK(bad == 0, "%s: %zu RGBA values wrong through veil_read_exr", path, bad);
+    }
+    free(back);
+
+    /* a channel the file lacks: cleared outputs, a message naming the
+     * file, the channel and the channels there are */
+    rw = rh = -1;
+    back = (float*)&rw;
+    memset(&err, 0, sizeof err);
+    veil_result r = veil_read_exr_channel(path, "stderr.A", &rw, &rh, &back, &err);
+    CHECK(r == VEIL_ERR_INVALID && back == NULL && rw == 0 && rh == 0, "missing channel: %s (%s)",
+          veil_result_name(r), err.msg);
+    CHECK(strstr(err.msg, path) && strstr(err.msg, "\"stderr.A\"") && strstr(err.msg, "\"stderr.R\"") &&
+              strstr(err.msg, "\"A\""),
+          "missing channel: the message should name the file, the channel and the file's channels: %s", err.msg);
+    r = veil_read_exr_channel(path, "r", &rw, &rh, &back, &err);
+    CHECK(r == VEIL_ERR_INVALID && back == NULL, "channel names are case-sensitive: %s", veil_result_name(r));
+    r = veil_read_exr_channel(path, "", &rw, &rh, &back, &err);
+    CHECK(r == VEIL_ERR_INVALID && strstr(err.msg, path), "empty channel name: %s (%s)", veil_result_name(r), err.msg);
+    r = veil_read_exr_channel(path, NULL, &rw, &rh, &back, &err);
+    CHECK(r == VEIL_ERR_INVALID, "no channel name: %s", veil_result_name(r));
+    r = veil_read_exr_channel(path, "R", &rw, NULL, &back, &err);
+    CHECK(r == VEIL_ERR_INVALID, "no height pointer: %s", veil_result_name(r));
+    char missing[256];
+    path_in(missing, sizeof missing, "missing.exr");
+    r = veil_read_exr_channel(missing, "R", &rw, &rh, &back, &err);
+    CHECK(r == VEIL_ERR_IO && back == NULL && strstr(err.msg, missing), "missing file: %s (%s)", veil_result_name(r),
+          err.msg);
+    unlink(path);
+    free(store);
+
+    /* one 1x1 channel */
+    const float one = 0.75f;
+    const float* one_plane[1] = {&one};
+    const char* const y_name[1] = {"Y"};
+    CHECK(veil_write_exr_planes(path, 1, 1, 1, y_name, one_plane, &err) == VEIL_OK, "write 1x1: %s", err.msg);
+    expect_plane(path, "Y", 1, 1, &one);
+    r = veil_read_exr(path, &rw, &rh, &back, &err);
+    CHECK(r == VEIL_ERR_IO && back == NULL && strstr(err.msg, "\"Y\""), "RGBA from a Y file: %s (%s)",
+          veil_result_name(r), err.msg);
+    unlink(path);
+
+    /* 64 channels with 255-character names */
+    {
+        enum { N = 64, W = 3, H = 2 };
+        static char names[N][256];
+        const char* name_ptrs[N];
+        float* values = malloc(sizeof(float) * N * W * H);
+        const float* ps[N];
+        for (int c = 0; c < N; ++c) {
+            memset(names[c], 'a' + c % 26, 252);
+            snprintf(names[c] + 252, 4, "%03u", (unsigned)c % 1000u);
+            name_ptrs[c] = names[c];
+            for (int i = 0; i < W * H; ++i) values[c * W * H + i] = (float)c * 10.0f + (float)i;
+            ps[c] = values + c * W * H;
+        }
+        CHECK(strlen(names[0]) == 255, "test name length %zu", strlen(names[0]));
+        CHECK(veil_write_exr_planes(path, W, H, N, name_ptrs, ps, &err) == VEIL_OK, "write 64 long-named channels: %s",
+              err.msg);
+        expect_plane(path, names[0], W, H, ps[0]);
+        expect_plane(path, names[37], W, H, ps[37]);
+        expect_plane(path, names[63], W, H, ps[63]);
+        float* none = NULL;
+        r = veil_read_exr_channel(path, "nope", &rw, &rh, &none, &err);
+        CHECK(r == VEIL_ERR_INVALID && strstr(err.msg, "\"nope\"") && strstr(err.msg, "...") && strstr(err.msg, path),
+              "a missing channel among 64 long names: %s (%s)", veil_result_name(r), err.msg);
+        free(values);
+        unlink(path);
+    }
+}
+
 /* Half inputs, other data windows, an extra channel, no alpha, tiles. */
 static void test_exr_foreign(void)
 {
@@ -401,6 +543,51 @@ static void test_exr_foreign(void)
         unlink(path);
     }
 
+    /* named half, float and uint channels, scanline (window off the origin)
+     * and tiled (partial tiles), read one at a time */
+    for (int tiled = 0; tiled <= 1; ++tiled) {
+        path_in(path, sizeof path, tiled ? "named_tiled.exr" : "named_scan.exr");
+        exr_attr_box2i_t dw;
+        dw.min.x = -2;
+        dw.min.y = 7;
+        dw.max.x = 8;
+        dw.max.y = 43;
+        const int W = 11, H = 37;
+        uint16_t* y = malloc(sizeof(uint16_t) * W * H);
+        float* depth = malloc(sizeof(float) * W * H);
+        uint32_t* id = malloc(sizeof(uint32_t) * W * H);
+        for (int i = 0; i < W * H; ++i) {
+            y[i] = halves[(i * 7 + tiled) % nh].bits;
+            depth[i] = random_finite();
+            id[i] = (uint32_t)i;
+        }
+        test_chan chans[3] = {{"Y", EXR_PIXEL_HALF, y}, {"depth", EXR_PIXEL_FLOAT, depth}, {"id", EXR_PIXEL_UINT, id}};
+        CHECK(core_write(path, EXR_COMPRESSION_ZIP, dw, tiled ? 5 : 0, chans, 3), "cannot make %s", path);
+        for (int c = 0; c < 2; ++c) {
+            float* plane = NULL;
+            rw = rh = 0;
+            veil_result r = veil_read_exr_channel(path, chans[c].name, &rw, &rh, &plane, &err);
+            CHECK(r == VEIL_OK && rw == W && rh == H, "%s: channel %s: %s, %dx%d (%s)", path, chans[c].name,
+                  veil_result_name(r), rw, rh, err.msg);
+            if (plane && rw == W && rh == H) {
+                int bad = 0;
+                for (int i = 0; i < W * H; ++i)
+                    if (!same_bits(plane[i], c == 0 ? halves[(i * 7 + tiled) % nh].value : depth[i])) ++bad;
+                CHECK(bad == 0, "%s: channel %s: %d values wrong", path, chans[c].name, bad);
+            }
+            free(plane);
+        }
+        float* plane = NULL;
+        veil_result r = veil_read_exr_channel(path, "id", &rw, &rh, &plane, &err);
+        CHECK(r == VEIL_ERR_IO && plane == NULL && strstr(err.msg, "id") && strstr(err.msg, "uint"),
+              "%s: a uint channel: %s (%s)", path, veil_result_name(r), err.msg);
+        free(plane);
+        free(y);
+        free(depth);
+        free(id);
+        unlink(path);
+    }
+
     /* no R/G/B: a clear refusal */
     {
         path_in(path, sizeof path, "only_y.exr");
@@ -429,6 +616,80 @@ static void expect_failed_write(const char* what, veil_result r, veil_result exp
     CHECK(strstr(err->msg, path) != NULL, "%s: message does not name %s: %s", what, path, err->msg);
     CHECK(entries == entries_before && temps == 0, "%s: directory has %d entries (%d temporary), expected %d", what,
           entries, temps, entries_before);
+}
+
+static void expect_invalid_planes(const char* what, const char* path, int w, int h, int n, const char* const* names,
+                                  const float* const* planes, const char* in_msg)
+{
+    veil_error err = {{0}};
+    veil_result r = veil_write_exr_planes(path, w, h, n, names, planes, &err);
+    CHECK(r == VEIL_ERR_INVALID, "%s: %s, expected VEIL_ERR_INVALID (%s)", what, veil_result_name(r), err.msg);
+    CHECK(strstr(err.msg, path) && (!in_msg || strstr(err.msg, in_msg)), "%s: the message should name %s and %s: %s",
+          what, path, in_msg ? in_msg : "nothing else", err.msg);
+    CHECK(!file_exists(path), "%s: %s exists", what, path);
+}
+
+static void test_exr_planes_failures(void)
+{
+    char path[256], dirpath[256];
+    float a[4 * 4] = {0}, b[4 * 4] = {0};
+    const float* ab[3] = {a, b, a};
+    const char* const rgb[3] = {"R", "G", "B"};
+    int base = count_entries(g_dir, NULL);
+
+    path_in(path, sizeof path, "planes_bad.exr");
+    const char* const dup[3] = {"R", "G", "R"};
+    expect_invalid_planes("duplicate names", path, 4, 4, 3, dup, ab, "\"R\"");
+    const char* const dup2[3] = {"stderr.R", "A", "stderr.R"};
+    expect_invalid_planes("duplicate long names", path, 4, 4, 3, dup2, ab, "\"stderr.R\"");
+    const char* const no_name[3] = {"R", NULL, "B"};
+    expect_invalid_planes("a NULL name", path, 4, 4, 3, no_name, ab, "channel 2");
+    const char* const empty[3] = {"R", "", "B"};
+    expect_invalid_planes("an empty name", path, 4, 4, 3, empty, ab, "channel 2");
+    char long_name[257];
+    memset(long_name, 'x', 256);
+    long_name[256] = '\0';
+    const char* const too_long[3] = {"R", "G", long_name};
+    expect_invalid_planes("a 256-character name", path, 4, 4, 3, too_long, ab, "256 characters");
+    const float* no_plane[3] = {a, NULL, b};
+    expect_invalid_planes("a NULL plane", path, 4, 4, 3, rgb, no_plane, "\"G\"");
+    expect_invalid_planes("no names", path, 4, 4, 3, NULL, ab, "names");
+    expect_invalid_planes("no planes", path, 4, 4, 3, rgb, NULL, "planes");
+    expect_invalid_planes("0 channels", path, 4, 4, 0, rgb, ab, "0 channels");
+    expect_invalid_planes("-1 channels", path, 4, 4, -1, rgb, ab, "-1 channels");
+    {
+        char names[65][16];
+        const char* name_ptrs[65];
+        const float* ps[65];
+        for (int c = 0; c < 65; ++c) {
+            snprintf(names[c], sizeof names[c], "c%d", c);
+            name_ptrs[c] = names[c];
+            ps[c] = a;
+        }
+        expect_invalid_planes("65 channels", path, 4, 4, 65, name_ptrs, ps, "65 channels");
+    }
+    static const int sizes[][2] = {{0, 4}, {4, 0}, {-1, 4}, {4, -7}, {INT_MAX, INT_MAX}};
+    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; ++i)
+        expect_invalid_planes("bad size", path, sizes[i][0], sizes[i][1], 3, rgb, ab, NULL);
+    veil_error err = {{0}};
+    CHECK(veil_write_exr_planes(NULL, 4, 4, 3, rgb, ab, &err) == VEIL_ERR_INVALID, "no path");
+    CHECK(veil_write_exr_planes("", 4, 4, 3, rgb, ab, &err) == VEIL_ERR_INVALID, "empty path");
+    CHECK(count_entries(g_dir, NULL) == base, "invalid plane writes created files");
+
+    /* into a directory that does not exist; onto a directory */
+    path_in(path, sizeof path, "no_such_dir/planes.exr");
+    memset(&err, 0, sizeof err);
+    expect_failed_write("planes into a missing directory", veil_write_exr_planes(path, 4, 4, 3, rgb, ab, &err),
+                        VEIL_ERR_IO, path, &err, base);
+    CHECK(!file_exists(path), "%s exists after a failed write", path);
+    path_in(dirpath, sizeof dirpath, "planes_dir.exr");
+    CHECK(mkdir(dirpath, 0700) == 0, "mkdir %s", dirpath);
+    memset(&err, 0, sizeof err);
+    expect_failed_write("planes onto a directory", veil_write_exr_planes(dirpath, 4, 4, 3, rgb, ab, &err),
+                        VEIL_ERR_IO, dirpath, &err, base + 1);
+    CHECK(count_entries(dirpath, NULL) == 0, "%s is not empty", dirpath);
+    rmdir(dirpath);
+    CHECK(count_entries(g_dir, NULL) == base, "failed plane writes left files");
 }
 
 static void test_write_failures(void)
@@ -607,8 +868,10 @@ int main(void)
     if (!test_dir_begin("test_exr")) return 1;
     test_exr_roundtrip();
     test_exr_channels();
+    test_exr_planes();
     test_exr_foreign();
     test_write_failures();
+    test_exr_planes_failures();
     test_read_failures();
     CHECK(test_dir_end(), "the test folder %s was not left empty", g_dir);
     return check_finish();

@@ -20,7 +20,8 @@
 // Empty space: where a brick of the EV and the voxel ring around it hold no
 // density (render/shaders/occupancy.comp) every sample in it would add
 // nothing, so without fog the march jumps to where the ray leaves the brick.
-// Output: rgb = L + T * background, a = 1 - mean(T).
+// Output: rgb = L + T * background, a = 1 - mean(T). With u_stop_t the
+// march ends at the first step boundary at or beyond it (the same steps).
 layout(local_size_x = VEIL_MARCH_GROUP, local_size_y = VEIL_MARCH_GROUP) in;
 
 layout(binding = VEIL_IMAGE_OUT, rgba32f) writeonly uniform image2D u_out;
@@ -41,6 +42,7 @@ uniform float u_step;               // m, inside the EV's box (no EV: the fog's 
 uniform float u_min_dist2;          // m^2, floor on |S - X|^2 of point lights
 uniform uint u_seed;
 uniform vec3 u_background;
+uniform float u_stop_t;             // m: no step starts at or beyond it (3e38: no limit)
 uniform int u_light_count;
 uniform int u_light_type[VEIL_MAX_LIGHTS];
 uniform vec3 u_light_pos[VEIL_MAX_LIGHTS];   // point, spot: position (m)
@@ -159,7 +161,7 @@ void main()
     float jitter = (float(h >> 8) + 1.0) * (1.0 / 16777216.0); // (0, 1]
     float t = t_begin;
     bool first = true;
-    while (t < t_end) {
+    while (t < t_end && t < u_stop_t) {
         vec3 x0 = u_cam_pos + dir * t;
         bool in_ev = u_has_volume != 0 && t >= ev.x && t < ev.y;
         if (in_ev && u_skip != 0) {

@@ -1,0 +1,207 @@
+/* veil compare A.exr REF.exr [--heatmap OUT.png] [--floor F] [--json]
+ *
+ * Compares image A against the reference REF (reference/compare.h has the
+ * metrics) and prints them, one a line (`rel_rmse 0.0123 (floor ...)`), or
+ * with --json as one JSON object:
+ *   {"image", "reference": paths, "width", "height", "floor", "rel_rmse",
+ *    "rmse", "max_abs", "off_5pct", "psnr_db", "alpha_max_abs",
+ *    "heatmap": path or null}
+ * Numbers are JSON numbers; "psnr_db" is null when the images' RGB are
+ * identical (MSE 0, PSNR infinite; the text form prints "inf"). No NaN is
+ * ever printed: every other number is finite for finite inputs.
+ *
+ * --heatmap OUT.png writes the per-pixel relative error (largest RGB
+ * channel, same floor) as an 8-bit RGB PNG through the colour map of
+ * veil_compare_heatmap_colour: log scale, black 1e-4 (and below, 0
+ * included), blue 1e-3, magenta 1e-2, yellow 1e-1, white 1 (and above).
+ *
+ * Exit codes: 0 compared, 1 bad input (a file missing, unreadable or not an
+ * EXR, sizes that differ, a non-finite pixel, the heatmap not writable; no
+ * heatmap is left behind), 2 usage.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/image.h"
+#include "reference/compare.h"
+#include "cli_util.h"
+#include "commands.h"
+
+typedef struct compare_args {
+    const char *image, *reference, *heatmap;
+    double floor; /* 0: the default */
+    int json;
+} compare_args;
+
+/* A number (strtod syntax), positive and finite. */
+static int parse_positive(const char* s, double* out)
+{
+    char* end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || *end || !isfinite(v) || !(v > 0.0)) return 0;
+    *out = v;
+    return 1;
+}
+
+/* -1 when the arguments are good, else the exit code. */
+static int parse_args(int argc, char** argv, compare_args* a)
+{
+    memset(a, 0, sizeof *a);
+    for (int i = 2; i < argc; ++i) {
+        const char* s = argv[i];
+        const char* v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(s, "--json")) {
+            a->json = 1;
+        } else if (!strcmp(s, "--heatmap") || !strcmp(s, "--floor")) {
+            if (!v) return veil_cli_usage_error("%s needs a value", s);
+            ++i;
+            if (!strcmp(s, "--heatmap")) {
+                if (!*v) return veil_cli_usage_error("%s", "--heatmap: expected a file name, got ''");
+                a->heatmap = v;
+            } else if (!parse_positive(v, &a->floor)) {
+                return veil_cli_usage_error(
+                    "--floor: expected a positive finite number (absolute, in the images' units), got '%s'", v);
+            }
+        } else if (s[0] == '-' && s[1]) {
+            return veil_cli_usage_error("unknown option '%s'", s);
+        } else if (!a->image) {
+            a->image = s;
+        } else if (!a->reference) {
+            a->reference = s;
+        } else {
+            return veil_cli_usage_error("unexpected argument '%s'", s);
+        }
+    }
+    if (!a->image) return veil_cli_usage_error("%s", "compare: missing A.exr and REF.exr");
+    if (!a->reference) return veil_cli_usage_error("%s", "compare: missing REF.exr");
+    return -1;
+}
+
+/* A JSON string: quotes, backslashes and control characters escaped; other
+ * bytes (UTF-8 file names) as they are. */
+static void print_json_string(const char* s)
+{
+    putchar('"');
+    for (const unsigned char* p = (const unsigned char*)s; *p; ++p) {
+        if (*p == '"' || *p == '\\') printf("\\%c", *p);
+        else if (*p < 0x20) printf("\\u%04x", *p);
+        else putchar(*p);
+    }
+    putchar('"');
+}
+
+/* A JSON number; null for a non-finite value (only PSNR can be one). */
+static void print_json_number(const char* key, double v, const char* after)
+{
+    printf("  \"%s\": ", key);
+    if (isfinite(v)) printf("%.17g", v);
+    else fputs("null", stdout);
+    fputs(after, stdout);
+}
+
+static void print_json(const compare_args* a, const veil_compare_stats* st)
+{
+    fputs("{\n  \"image\": ", stdout);
+    print_json_string(a->image);
+    fputs(",\n  \"reference\": ", stdout);
+    print_json_string(a->reference);
+    printf(",\n  \"width\": %d,\n  \"height\": %d,\n", st->width, st->height);
+    print_json_number("floor", st->floor, ",\n");
+    print_json_number("rel_rmse", st->rel_rmse, ",\n");
+    print_json_number("rmse", st->rmse, ",\n");
+    print_json_number("max_abs", st->max_abs, ",\n");
+    print_json_number("off_5pct", st->frac_off, ",\n");
+    print_json_number("psnr_db", st->psnr_db, ",\n");
+    print_json_number("alpha_max_abs", st->alpha_max_abs, ",\n");
+    fputs("  \"heatmap\": ", stdout);
+    if (a->heatmap) print_json_string(a->heatmap);
+    else fputs("null", stdout);
+    fputs("\n}\n", stdout);
+}
+
+/* A power of ten as "1e-4" ("1" for 10^0): the heatmap's scale is whole decades. */
+static void decade(double v, char out[16])
+{
+    long e = lround(log10(v));
+    if (e == 0) snprintf(out, 16, "1");
+    else snprintf(out, 16, "1e%ld", e);
+}
+
+static void print_text(const compare_args* a, const veil_compare_stats* st)
+{
+    printf("image          %s\n", a->image);
+    printf("reference      %s (%dx%d)\n", a->reference, st->width, st->height);
+    printf("rel_rmse       %.6g (floor %.6g%s)\n", st->rel_rmse, st->floor, a->floor > 0.0 ? "" : ", default");
+    printf("rmse           %.6g\n", st->rmse);
+    printf("max_abs        %.6g\n", st->max_abs);
+    printf("off_5pct       %.6g (fraction of pixels more than %g%% off)\n", st->frac_off,
+           100.0 * VEIL_COMPARE_OFF_FRACTION);
+    if (isfinite(st->psnr_db)) printf("psnr_db        %.6g (peak: the reference's largest RGB value)\n", st->psnr_db);
+    else printf("psnr_db        inf (identical RGB)\n");
+    printf("alpha_max_abs  %.6g\n", st->alpha_max_abs);
+    if (a->heatmap) {
+        char lo[16], hi[16], blue[16], magenta[16], yellow[16];
+        decade(VEIL_COMPARE_HEATMAP_MIN, lo), decade(VEIL_COMPARE_HEATMAP_MAX, hi);
+        decade(VEIL_COMPARE_HEATMAP_MIN * 10.0, blue), decade(VEIL_COMPARE_HEATMAP_MIN * 100.0, magenta);
+        decade(VEIL_COMPARE_HEATMAP_MIN * 1000.0, yellow);
+        printf("heatmap %s: relative error, log scale %s (black) .. %s (white); %s blue, %s magenta, %s yellow\n",
+               a->heatmap, lo, hi, blue, magenta, yellow);
+    }
+}
+
+static veil_result write_heatmap(const char* path, int w, int h, const float* rel, veil_error* err)
+{
+    size_t n = (size_t)w * (size_t)h; /* fits: the images of this size were allocated */
+    unsigned char* rgb = malloc(n * 3);
+    if (!rgb) return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory for a %dx%d heatmap", path, w, h);
+    for (size_t i = 0; i < n; ++i) veil_compare_heatmap_colour(rel[i], rgb + i * 3);
+    veil_result r = veil_write_png_rgb8(path, w, h, rgb, err);
+    free(rgb);
+    return r;
+}
+
+int veil_cmd_compare(int argc, char** argv)
+{
+    compare_args a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc >= 0) return rc;
+
+    veil_error err = {0};
+    int wa = 0, ha = 0, wb = 0, hb = 0;
+    float *img = NULL, *ref = NULL, *rel = NULL;
+    veil_result r = a.heatmap ? veil_cli_check_output_folder(a.heatmap, &err) : VEIL_OK;
+    if (r == VEIL_OK) r = veil_read_exr(a.image, &wa, &ha, &img, &err);
+    if (r == VEIL_OK) r = veil_read_exr(a.reference, &wb, &hb, &ref, &err);
+    if (r == VEIL_OK && (wa != wb || ha != hb))
+        r = veil_fail(&err, VEIL_ERR_INVALID, "%s is %dx%d but the reference %s is %dx%d: the sizes must match",
+                      a.image, wa, ha, a.reference, wb, hb);
+    if (r == VEIL_OK && a.heatmap) {
+        size_t bytes = 0;
+        if (!veil_mul_sizes((size_t)wa, (size_t)ha, sizeof(float), 1, &bytes) || !(rel = malloc(bytes)))
+            r = veil_fail(&err, VEIL_ERR_OOM, "%s: out of memory for a %dx%d heatmap", a.heatmap, wa, ha);
+    }
+    veil_compare_stats st = {0};
+    if (r == VEIL_OK) {
+        r = veil_compare_images(img, ref, wa, ha, a.floor, &st, rel, &err);
+        if (r != VEIL_OK) {
+            char tmp[VEIL_ERROR_MAX];
+            snprintf(tmp, sizeof tmp, "%.500s (image) against %.500s (reference): %.1000s", a.image, a.reference,
+                     err.msg);
+            memcpy(err.msg, tmp, sizeof tmp);
+        }
+    }
+    if (r == VEIL_OK && a.heatmap) r = write_heatmap(a.heatmap, wa, ha, rel, &err);
+    free(img);
+    free(ref);
+    free(rel);
+    if (r != VEIL_OK) return veil_cli_fail(r, &err);
+
+    if (a.json) print_json(&a, &st);
+    else print_text(&a, &st);
+    return EXIT_OK;
+}

@@ -1,0 +1,1 @@
+# The stress test over extreme scenes (being written).

@@ -1,0 +1,119 @@
+#define _POSIX_C_SOURCE 200809L /* stat: st_mtim */
+#include "scene_volume.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "../core/hash.h"
+#include "vdb_volume.h"
+
+void veil_scene_volume_close(veil_scene_volume* v)
+{
+    if (!v) return;
+    for (int i = 0; i < v->vdb_count; ++i) veil_vdb_close(v->vdbs[i]);
+    free(v->particles);
+    memset(v, 0, sizeof *v);
+}
+
+/* Grows [lo, hi] (valid when *any) by the box [a, b]. */
+static void grow(float lo[3], float hi[3], int* any, const float a[3], const float b[3])
+{
+    for (int k = 0; k < 3; ++k) {
+        lo[k] = *any ? fminf(lo[k], a[k]) : a[k];
+        hi[k] = *any ? fmaxf(hi[k], b[k]) : b[k];
+    }
+    *any = 1;
+}
+
+/* Opens source i's grid and mixes its identity (path, chosen grid, size and
+ * modification time, scale, level-set mode; not its bytes) into the key. */
+static veil_result open_vdb(veil_scene_volume* v, const veil_source* src, size_t i, float lo[3], float hi[3],
+                            int* any, veil_error* err)
+{
+    if (v->vdb_count == VEIL_MAX_VDB_SOURCES)
+        return veil_fail(err, VEIL_ERR_LIMIT, "medium.sources[%zu]: at most %d vdb sources", i, VEIL_MAX_VDB_SOURCES);
+    char chosen[256];
+    veil_vdb* vdb = NULL;
+    veil_result r = veil_vdb_open(src->vdb.file, src->vdb.grid, src->vdb.level_set_to_fog, &vdb, chosen,
+                                  sizeof chosen, err);
+    if (r != VEIL_OK) {
+        veil_error inner = *err;
+        return veil_fail(err, r, "medium.sources[%zu]: %.1900s", i, inner.msg);
+    }
+    v->vdbs[v->vdb_count] = vdb;
+    v->vdb_scale[v->vdb_count++] = src->vdb.density_scale;
+    struct stat sb;
+    memset(&sb, 0, sizeof sb);
+    stat(src->vdb.file, &sb);
+    uint64_t k = veil_hash_bytes(v->key, src->vdb.file, strlen(src->vdb.file));
+    k = veil_hash_bytes(k, chosen, strlen(chosen));
+    k = veil_hash_bytes(k, &sb.st_size, sizeof sb.st_size);
+    k = veil_hash_bytes(k, &sb.st_mtim, sizeof sb.st_mtim);
+    k = veil_hash_bytes(k, &src->vdb.density_scale, sizeof src->vdb.density_scale);
+    v->key = veil_hash_bytes(k, &src->vdb.level_set_to_fog, sizeof src->vdb.level_set_to_fog);
+    int ilo[3], ihi[3];
+    size_t active = 0;
+    r = veil_vdb_index_bbox(vdb, ilo, ihi, &active);
+    if (r == VEIL_OK && active > 0 && src->vdb.density_scale > 0.0f) {
+        float a[3], b[3];
+        r = veil_vdb_world_support(vdb, a, b, err);
+        if (r == VEIL_OK) grow(lo, hi, any, a, b);
+    }
+    v->vdb_voxels += active;
+    return r;
+}
+
+veil_result veil_scene_volume_open(const veil_scene* s, veil_scene_volume* out, veil_error* err)
+{
+    veil_scene_volume v;
+    memset(&v, 0, sizeof v);
+    v.key = veil_hash_bytes(VEIL_FNV_OFFSET, &s->medium.max_resolution, sizeof s->medium.max_resolution);
+    memset(out, 0, sizeof *out);
+    veil_result r = veil_scene_particles(s, &v.particles, &v.particle_count, err);
+    float lo[3], hi[3], a[3], b[3];
+    int any = 0;
+    for (size_t i = 0; i < s->medium.source_count && r == VEIL_OK; ++i)
+        if (s->medium.sources[i].type == VEIL_SOURCE_VDB) r = open_vdb(&v, &s->medium.sources[i], i, lo, hi, &any, err);
+    if (r == VEIL_OK) {
+        v.key = veil_hash_bytes(v.key, v.particles, v.particle_count * sizeof *v.particles);
+        if (veil_rbf_bounds(v.particles, v.particle_count, a, b)) grow(lo, hi, &any, a, b);
+        if (any) r = veil_grid_fit(lo, hi, s->medium.max_resolution, &v.grid, err);
+        v.has_volume = any;
+    }
+    if (r != VEIL_OK) {
+        veil_scene_volume_close(&v);
+        return r;
+    }
+    *out = v;
+    return VEIL_OK;
+}
+
+veil_result veil_scene_volume_add_vdbs(const veil_scene_volume* v, float* density, veil_error* err)
+{
+    veil_result r = VEIL_OK;
+    for (int i = 0; i < v->vdb_count && r == VEIL_OK; ++i) r = veil_vdb_to_grid(v->vdbs[i], v->vdb_scale[i], &v->grid, density, err);
+    return r;
+}
+
+veil_result veil_scene_volume_density(const veil_scene_volume* v, float** density, veil_error* err)
+{
+    *density = NULL;
+    if (!v->has_volume) return veil_fail(err, VEIL_ERR_INVALID, "the scene has no voxelised source");
+    size_t n = veil_grid_voxels(&v->grid);
+    float* d = calloc(n, sizeof(float));
+    if (!d) return veil_fail(err, VEIL_ERR_OOM, "out of memory for a %zu-voxel volume", n);
+    veil_result r = veil_scene_volume_add_vdbs(v, d, err);
+    if (r == VEIL_OK && v->particle_count > 0) {
+        veil_rbf_bins bins = {0};
+        r = veil_rbf_bin(&v->grid, v->particles, v->particle_count, &bins, err);
+        if (r == VEIL_OK) veil_inject_rbf_cpu(&v->grid, &bins, d);
+        veil_rbf_bins_free(&bins);
+    }
+    if (r != VEIL_OK) {
+        free(d);
+        return r;
+    }
+    *density = d;
+    return VEIL_OK;
+}

@@ -1,0 +1,53 @@
+/* veil — a scene's voxelised sources, gathered once for every renderer.
+ *
+ * The extinction volume of a scene is made from its RBF particles (explicit
+ * and generated) and its OpenVDB grids; analytic fog is never voxelised.
+ * veil_scene_volume_open() collects the particles, opens the grids, fits
+ * the grid that holds them all (veil_grid_fit over the union of the
+ * particles' cut-off boxes and the grids' supports, medium.max_resolution
+ * voxels along the longest side) and forms a content key. The GPU renderer
+ * then splats the particles on the GPU; the CPU reference
+ * (veil_scene_volume_density) splats them with veil_inject_rbf_cpu. Both
+ * resample the grids with veil_vdb_to_grid first, so the two see the same
+ * volume (the splats agree to ~1e-6 relative, tests/test_inject_gpu.c).
+ */
+#ifndef VEIL_SCENE_VOLUME_H
+#define VEIL_SCENE_VOLUME_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../core/result.h"
+#include "../io/scene.h"
+#include "../io/vdb.h"
+#include "volume.h"
+
+/* At most this many OpenVDB grids in one scene. */
+#define VEIL_MAX_VDB_SOURCES 8
+
+typedef struct veil_scene_volume {
+    veil_particle* particles; /* all RBF particles (owned) */
+    size_t particle_count;
+    veil_vdb* vdbs[VEIL_MAX_VDB_SOURCES]; /* opened grids (owned) */
+    float vdb_scale[VEIL_MAX_VDB_SOURCES]; /* their density_scale */
+    int vdb_count;
+    size_t vdb_voxels; /* active voxels over all grids */
+    uint64_t key;      /* content key: resolution, particles, grid files' identities */
+    int has_volume;    /* 0: nothing to voxelise (then `grid` is unset) */
+    veil_grid grid;
+} veil_scene_volume;
+
+/* Errors name the source (`medium.sources[i]: ...`). On failure *out is
+ * left closed (nothing to free). */
+veil_result veil_scene_volume_open(const veil_scene* s, veil_scene_volume* out, veil_error* err);
+void veil_scene_volume_close(veil_scene_volume* v); /* accepts a zeroed one */
+
+/* Adds the resampled OpenVDB grids to density (veil_grid_voxels(&v->grid)
+ * floats). */
+veil_result veil_scene_volume_add_vdbs(const veil_scene_volume* v, float* density, veil_error* err);
+
+/* The whole volume on the CPU: grids resampled, particles splatted, into a
+ * newly calloc'd *density (free() it). Needs v->has_volume. */
+veil_result veil_scene_volume_density(const veil_scene_volume* v, float** density, veil_error* err);
+
+#endif
