@@ -71,7 +71,7 @@
 #include "../volume/volume.h"
 
 #define VEIL_PT_MAJORANT_BLOCK 4
-#define VEIL_PT_MAX_EVENTS 10000000
+#define VEIL_PT_MAX_EVENTS 1000000
 
 typedef struct veil_pt_medium veil_pt_medium;
 

@@ -122,7 +122,9 @@ vec3 in_scattered(vec3 x, vec3 dir)
             len = INF;
         }
         if (max(E.r, max(E.g, E.b)) <= 0.0) continue;
-        float D = ev_depth(l, x, -travel, len) + fog_integral(x, -travel, 0.0, len);
+        // a fog's closed form overflows to +inf for rho0 e^60 len > 3.4e38: keep D
+        // finite so that a channel with sigma_t = 0 gets exp(0) = 1, not exp(0 * inf) = NaN
+        float D = min(ev_depth(l, x, -travel, len) + fog_integral(x, -travel, 0.0, len), INF);
         float cos_theta = clamp(dot(travel, -dir), -1.0, 1.0);
         sum += E * exp(-u_sigma_t * D) * veil_phase_hg(cos_theta, u_g);
     }
@@ -170,7 +172,8 @@ void main()
             if (texelFetch(u_occ, b, 0).r <= 0.0) {
                 vec3 lo = u_tex_min + (vec3(b * VEIL_BRICK) + 0.5) * u_voxel;
                 float exit_t = box_hit(u_cam_pos, dir, lo, lo + float(VEIL_BRICK) * u_voxel, t, INF).y;
-                t = max(exit_t, t + 1e-4 * u_step);
+                // past the exit by a hair that float t can hold (t + 1e-4 step may round to t)
+                t = max(exit_t, t) + max(1e-4 * u_step, 2.4e-7 * abs(t));
                 continue;
             }
         }
@@ -183,11 +186,15 @@ void main()
         float dt = te - t;
         vec3 x = u_cam_pos + dir * (0.5 * (t + te));
         float rho_dt = in_ev ? texture(u_ev, (x - u_tex_min) * u_tex_inv_size).r * dt : 0.0;
-        rho_dt += fog_integral(u_cam_pos, dir, t, te);
+        rho_dt = min(rho_dt + fog_integral(u_cam_pos, dir, t, te), INF); // finite, as D in in_scattered
         if (rho_dt > 0.0) {
             vec3 opt = u_sigma_t * rho_dt;
             vec3 frac = vec3(veil_step_integral(opt.r), veil_step_integral(opt.g), veil_step_integral(opt.b));
-            L += T * (u_sigma_s * rho_dt) * in_scattered(x, dir) * frac;
+            // sigma_s (rho_dt frac) = sigma_s (1 - exp(-opt)) / sigma_t <= 1: in this order (precise:
+            // not reassociated) nothing overflows; rho_dt * L_in first can (dense fog near a light),
+            // and 0 * inf in a channel without scattering is NaN
+            precise vec3 w = T * (u_sigma_s * (rho_dt * frac));
+            L += w * in_scattered(x, dir);
             T *= exp(-opt);
             if (max(T.r, max(T.g, T.b)) < VEIL_MIN_TRANSMITTANCE) break;
         }
