@@ -33,7 +33,7 @@
  *    counted and printed.
  * A scene the library rejects with an error is counted (and its message
  * shown); more than 5 % rejected means the generator makes invalid scenes.
- *   test_stress [SCENES [SEED [FIRST]]]   (default 500 scenes, seed 0x57e55, from scene 0)
+ *   test_stress [SCENES [SEED [FIRST]]]   (default 500 scenes, seed 3, from scene 0)
  * Scene i draws from its own stream (SEED, i): `test_stress 1 SEED i` redoes it alone. */
 #include <float.h>
 #include <math.h>
@@ -640,7 +640,7 @@ static int run_scene(veil_renderer* r, int scene, const sbuf* json, gen_scene* g
 int main(int argc, char** argv)
 {
     const int scenes = argc > 1 ? atoi(argv[1]) : 500;
-    const uint64_t seed = argc > 2 ? strtoull(argv[2], NULL, 0) : 0x57e55u;
+    const uint64_t seed = argc > 2 ? strtoull(argv[2], NULL, 0) : 3; /* meets both bugs fixed in march.comp */
     const int first = argc > 3 ? atoi(argv[3]) : 0;
     veil_gl* gl = check_gpu_or_skip();
     veil_renderer* r = NULL;
