@@ -87,46 +87,8 @@ static void flush_data(png_structp png)
     }
 }
 
-/* Everything libpng may longjmp out of lives here; nothing that is modified
- * after setjmp is read after the jump. Returns 1 on success. */
-static int encode_png(FILE* fp, int width, int height, const float* rgba, float scale, unsigned char* row,
-                      png_msg* msg)
-{
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, msg, on_png_error, on_png_warning);
-    if (!png) {
-        snprintf(msg->text, sizeof msg->text, "cannot create the libpng write structure");
-        return 0;
-    }
-    png_infop info = png_create_info_struct(png);
-    if (!info) {
-        png_destroy_write_struct(&png, NULL);
-        snprintf(msg->text, sizeof msg->text, "cannot create the libpng info structure");
-        return 0;
-    }
-    if (setjmp(png_jmpbuf(png))) {
-        png_destroy_write_struct(&png, &info);
-        return 0;
-    }
-    png_set_write_fn(png, fp, write_data, flush_data);
-    png_set_user_limits(png, 0x7fffffffu, 0x7fffffffu);
-    png_set_IHDR(png, info, (png_uint_32)width, (png_uint_32)height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
-    png_write_info(png, info);
-    for (int y = 0; y < height; ++y) {
-        const float* src = rgba + (size_t)y * (size_t)width * 4;
-        for (int x = 0; x < width; ++x) {
-            row[(size_t)x * 3 + 0] = encode_channel(src[(size_t)x * 4 + 0], scale);
-            row[(size_t)x * 3 + 1] = encode_channel(src[(size_t)x * 4 + 1], scale);
-            row[(size_t)x * 3 + 2] = encode_channel(src[(size_t)x * 4 + 2], scale);
-        }
-        png_write_row(png, row);
-    }
-    png_write_end(png, info);
-    png_destroy_write_struct(&png, &info);
-    return 1;
-}
-
+/* The preview is tone-mapped into 8-bit sRGB bytes first, then written by
+ * veil_write_png_rgb8 (one PNG writer, one temp-file-and-rename path). */
 veil_result veil_write_png(const char* path, int width, int height, const float* rgba, float exposure,
                            veil_error* err)
 {
@@ -138,56 +100,20 @@ veil_result veil_write_png(const char* path, int width, int height, const float*
     if (!veil_mul_sizes((size_t)width, (size_t)height, 4, sizeof(float), &bytes))
         return veil_fail(err, VEIL_ERR_INVALID, "%s: image size %dx%d is too large", path, width, height);
     if (!rgba) return veil_fail(err, VEIL_ERR_INVALID, "%s: no pixel data given", path);
-
-    unsigned char* row = malloc((size_t)width * 3);
-    if (!row) return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory for a PNG row of %d pixels", path, width);
-
-    char* tmp = NULL;
-    int fd = veil_open_temp_beside(path, &tmp);
-    if (fd < 0) {
-        int e = errno;
-        free(row);
-        if (e == 0)
-            return veil_fail(err, VEIL_ERR_IO, "%s: exists and is not a regular file; not replacing it", path);
-        return veil_fail(err, VEIL_ERR_IO, "%s: cannot create a temporary file beside it: %s", path, strerror(e));
-    }
-    FILE* fp = fdopen(fd, "wb");
-    if (!fp) {
-        int e = errno;
-        close(fd);
-        unlink(tmp);
-        free(tmp);
-        free(row);
-        return veil_fail(err, VEIL_ERR_IO, "%s: cannot open a stream on the temporary file: %s", path, strerror(e));
-    }
-
-    png_msg msg = {{0}};
+    size_t n = (size_t)width * (size_t)height;
+    unsigned char* rgb = malloc(n * 3);
+    if (!rgb) return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory for a %dx%d preview", path, width, height);
     const float scale = exp2f(exposure);
-    veil_result result = VEIL_OK;
-    if (!encode_png(fp, width, height, rgba, scale, row, &msg)) {
-        fclose(fp);
-        result = veil_fail(err, VEIL_ERR_IO, "%s: cannot write PNG: %s", path, msg.text);
-    } else {
-        int failed = fflush(fp) != 0 || ferror(fp);
-        int e = errno;
-        if (fclose(fp) != 0 && !failed) {
-            failed = 1;
-            e = errno;
-        }
-        if (failed)
-            result = veil_fail(err, VEIL_ERR_IO, "%s: cannot write PNG: writing %s failed: %s", path, tmp,
-                               strerror(e));
-        else if (rename(tmp, path) != 0)
-            result = veil_fail(err, VEIL_ERR_IO, "%s: cannot move the temporary file %s into place: %s", path, tmp,
-                               strerror(errno));
-    }
-    if (result != VEIL_OK) unlink(tmp);
-    free(tmp);
-    free(row);
-    return result;
+    for (size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 3; ++c) rgb[i * 3 + (size_t)c] = encode_channel(rgba[i * 4 + (size_t)c], scale);
+    veil_result r = veil_write_png_rgb8(path, width, height, rgb, err);
+    free(rgb);
+    return r;
 }
 
-/* As encode_png, for rows of bytes stored as given. Returns 1 on success. */
+/* Everything libpng may longjmp out of lives here; nothing that is modified
+ * after setjmp is read after the jump. Rows of bytes are stored as given.
+ * Returns 1 on success. */
 static int encode_png_rgb8(FILE* fp, int width, int height, const unsigned char* rgb, png_msg* msg)
 {
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, msg, on_png_error, on_png_warning);
