@@ -40,9 +40,9 @@
 #include <unistd.h>
 
 #include "reference/compare.h"
-#include "render/gl_context.h"
-#include "render/gl_util.h"
-#include "render/renderer.h"
+#include "gpu/gl_context.h"
+#include "gpu/gl_util.h"
+#include "frame/renderer.h"
 
 #include "accuracy_report.h"
 #include "accuracy_scenes.h"

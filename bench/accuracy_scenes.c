@@ -13,7 +13,7 @@
 #include "io/image.h"
 #include "reference/compare.h"
 #include "reference/pathtracer.h"
-#include "render/gl_util.h"
+#include "gpu/gl_util.h"
 
 #ifndef VEIL_SOURCE_DIR
 #define VEIL_SOURCE_DIR "."

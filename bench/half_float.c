@@ -38,9 +38,9 @@
 #include "media.h"
 #include "propagate/opv.h"
 #include "reference/optical_depth.h"
-#include "render/gl_context.h"
-#include "render/gl_util.h"
-#include "render/renderer.h"
+#include "gpu/gl_context.h"
+#include "gpu/gl_util.h"
+#include "frame/renderer.h"
 
 #define HALF_MAX 65504.0
 #define HALF_MIN_NORMAL 0x1p-14 /* 6.1e-5 */

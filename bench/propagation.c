@@ -42,9 +42,9 @@
 #include "propagate/opv.h"
 #include "propagate/opv_gpu.h"
 #include "reference/optical_depth.h"
-#include "render/gl_context.h"
-#include "render/gl_util.h"
-#include "render/renderer.h"
+#include "gpu/gl_context.h"
+#include "gpu/gl_util.h"
+#include "frame/renderer.h"
 #include "volume/rbf.h"
 #include "volume/volume.h"
 

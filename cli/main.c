@@ -26,9 +26,9 @@
 #include "io/particles.h"
 #include "io/scene.h"
 #include "io/vdb.h"
-#include "render/gl_context.h"
-#include "render/gl_util.h"
-#include "render/renderer.h"
+#include "gpu/gl_context.h"
+#include "gpu/gl_util.h"
+#include "frame/renderer.h"
 #include "cli_util.h"
 #include "commands.h"
 

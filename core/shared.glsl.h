@@ -21,6 +21,12 @@
 #define VEIL_MAXF max
 #define VEIL_FLOAT(x) float(x)
 #define VEIL_INT(x) int(x)
+/* std140 blocks: only 16-byte members, so C and GLSL lay them out alike */
+#define VEIL_V4(name) vec4 name
+#define VEIL_IV4(name) ivec4 name
+#define VEIL_UV4(name) uvec4 name
+#define VEIL_STRUCT_BEGIN(name) struct name {
+#define VEIL_STRUCT_END(name) };
 #else
 #include <math.h>
 #define VEIL_FN static inline
@@ -34,6 +40,12 @@
 #define VEIL_MAXF fmaxf
 #define VEIL_FLOAT(x) ((float)(x))
 #define VEIL_INT(x) ((int)(x))
+#include <stdint.h>
+#define VEIL_V4(name) float name[4]
+#define VEIL_IV4(name) int32_t name[4]
+#define VEIL_UV4(name) uint32_t name[4]
+#define VEIL_STRUCT_BEGIN(name) typedef struct name {
+#define VEIL_STRUCT_END(name) } name;
 #endif
 
 #define VEIL_PI 3.14159265358979323846
@@ -54,8 +66,13 @@
 #define VEIL_LIGHT_DIRECTIONAL 1
 #define VEIL_LIGHT_SPOT 2
 
-/* Work group of the ray marcher: 8x8 pixels. */
+/* Work groups, declared once for the shaders' local_size and the C code
+ * that dispatches them. The ray marcher: 8x8 pixels. The occupancy pass:
+ * 4^3 bricks. The ordered optical-depth sweep: 128 voxels of one shell or
+ * slice in a row. */
 #define VEIL_MARCH_GROUP 8
+#define VEIL_OCCUPANCY_GROUP 4
+#define VEIL_SWEEP_GROUP 128
 
 /* Outside the extinction volume the marcher's steps through fog grow with
  * the distance travelled: this fraction of it (fog and light vary on the
@@ -81,10 +98,51 @@
 #define VEIL_IMAGE_EV 0         /* image unit: r32f extinction (density) volume */
 #define VEIL_IMAGE_OPV_SRC 1    /* image unit: rgba32f optical depth, read */
 #define VEIL_IMAGE_OPV_DST 2    /* image unit: rgba32f optical depth, written */
-#define VEIL_IMAGE_OUT 3        /* image unit: rgba32f output image */
+#define VEIL_IMAGE_OUT 3        /* image unit: rgba32f output image (march: radiance, alpha) */
+#define VEIL_IMAGE_AOV_T 4      /* image unit: rgba32f march AOV: transmittance rgb, P */
+#define VEIL_IMAGE_AOV_S 5      /* image unit: rgba32f march AOV: single scattering rgb, depth */
+#define VEIL_UBO_MARCH 0        /* uniform block: veil_march_block */
 #define VEIL_TEX_EV 0           /* texture unit: sampled EV */
 #define VEIL_TEX_OPV0 1         /* texture units 1..4: sampled OPVs */
 #define VEIL_TEX_OCC 5          /* texture unit: occupancy bricks (max density per brick) */
+
+/* A light as the GPU sees it: one shape for every shader (std140, 48 bytes).
+ * Filled from scene/scene.h's veil_light by veil_gpu_light_from(). */
+VEIL_STRUCT_BEGIN(veil_gpu_light)
+    VEIL_V4(position);  /* xyz: point, spot position (m); w: type, VEIL_LIGHT_* */
+    VEIL_V4(direction); /* xyz: directional: unit travel direction; spot: its axis; w: spot cos(inner angle) */
+    VEIL_V4(color);     /* rgb: W/sr (point, spot) or W/m^2 (directional); w: spot cos(outer angle) */
+VEIL_STRUCT_END(veil_gpu_light)
+
+/* An exponential fog: density * exp(-falloff <x - origin, direction>) in its box. */
+VEIL_STRUCT_BEGIN(veil_gpu_fog)
+    VEIL_V4(direction); /* xyz: unit n; w: density at the origin plane */
+    VEIL_V4(origin);    /* xyz: m; w: falloff (m^-1) */
+    VEIL_V4(box_min);   /* xyz: m */
+    VEIL_V4(box_max);   /* xyz: m */
+VEIL_STRUCT_END(veil_gpu_fog)
+
+/* Everything the ray marcher (render/shaders/march.comp) reads besides its
+ * textures, in one std140 uniform block at VEIL_UBO_MARCH. */
+VEIL_STRUCT_BEGIN(veil_march_block)
+    VEIL_V4(cam_pos);      /* xyz: camera position (m) */
+    VEIL_V4(cam_fwd);      /* xyz: unit view direction */
+    VEIL_V4(cam_right);    /* xyz: right, scaled by tan(fov/2) and the aspect */
+    VEIL_V4(cam_up);       /* xyz: up, scaled by tan(fov/2) */
+    VEIL_V4(box_min);      /* xyz: the EV's medium, first voxel centre (m) */
+    VEIL_V4(box_max);      /* xyz: last voxel centre (m) */
+    VEIL_V4(tex_min);      /* xyz: texture coordinates are (x - tex_min) * tex_inv_size */
+    VEIL_V4(tex_inv_size); /* xyz: m^-1 */
+    VEIL_V4(sigma_t);      /* rgb: m^-1 per unit density */
+    VEIL_V4(sigma_s);      /* rgb: m^-1 per unit density */
+    VEIL_V4(background);   /* rgb: radiance behind the medium */
+    VEIL_V4(march);        /* x: step (m), y: floor on |S - X|^2 (m^2), z: voxel (m), w: HG g */
+    VEIL_V4(limits);       /* x: no step starts at or beyond this distance (m; 3e38: no limit) */
+    VEIL_IV4(size);        /* x, y: image size (pixels); z: lights; w: fogs */
+    VEIL_UV4(flags);       /* x: has a volume, y: skip empty bricks, z: jitter seed */
+    veil_gpu_light lights[VEIL_MAX_LIGHTS];
+    veil_gpu_fog fogs[VEIL_MAX_FOGS];
+VEIL_STRUCT_END(veil_march_block)
 
 /* Henyey–Greenstein phase function (sr^-1), cos_theta the cosine between the
  * light's travel direction and the scattered direction; g = 0 is isotropic

@@ -56,12 +56,6 @@ extern const range VEIL__R_SEED;
 #define VEIL__JR_PRINTF __attribute__((format(printf, 3, 4)))
 #else
 #define VEIL__JR_PRINTF
-/* The whole file `path`, NUL-terminated, into a malloc'd *buf (*len bytes
- * before the NUL); at most `limit` bytes, refused above with a message
- * naming the limit for `kind` files ("scene", "particle"). */
-veil_result veil__read_file(const char* path, size_t limit, const char* kind, char** buf, size_t* len,
-                            veil_error* err);
-
 #endif
 
 size_t veil__jr_path_format(const jpath* p, char* buf, size_t n);

@@ -1,5 +1,5 @@
 /* veil — RBF particle files: JSON and the compact little-endian binary
- * format (docs/particles.md), and the fBm modulation of `veil rbf generate`. */
+ * format (docs/particles.md). */
 #define _POSIX_C_SOURCE 200809L
 #include "particles.h"
 
@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "json_read.h"
-#include "scene_sources.h"
+#include "particles_json.h"
 #include "scene.h"
 #include "tempfile.h"
 
@@ -21,6 +21,7 @@
 #define PARTICLES_MAX_FILE_BYTES ((size_t)2 << 30)
 
 static const char* const FILE_KEYS[] = {"format", "version", "particles", NULL};
+static const char* const PARTICLE_KEYS[] = {"center", "amplitude", "sharpness", NULL};
 static const char* const FIELD_NAMES[5] = {"center[0]", "center[1]", "center[2]", "amplitude", "sharpness"};
 
 /* ---- checks shared by reader and writer -------------------------------- */
@@ -109,6 +110,29 @@ static veil_result read_binary(const char* path, const unsigned char* b, size_t 
         }
     }
     *out = p, *count = n;
+    return VEIL_OK;
+}
+
+veil_result veil__parse_particle_array(const ctx* c, const cJSON* obj, const jpath* p, veil_particle** out,
+                                      size_t* count)
+{
+    const cJSON* arr, *e;
+    size_t i = 0;
+    TRY(veil__jr_get_container(c, obj, p, true, true, &arr));
+    void* items = NULL;
+    TRY(veil__jr_alloc_items(c, p, arr, sizeof **out, VEIL_SCENE_MAX_PARTICLES, &items, count));
+    *out = items;
+    cJSON_ArrayForEach(e, arr) {
+        const jpath ep = {p, NULL, i};
+        veil_particle* q = &(*out)[i++];
+        double amp, sharp;
+        if (!cJSON_IsObject(e)) return veil__jr_expected(c, &ep, "an object", e);
+        TRY(veil__jr_check_keys(c, e, &ep, PARTICLE_KEYS));
+        TRY(veil__jr_get_floats(c, e, &ep, "center", true, 3, false, q->center));
+        TRY(veil__jr_get_number(c, e, &ep, "amplitude", true, &VEIL__R_NONNEG, &amp));
+        TRY(veil__jr_get_number(c, e, &ep, "sharpness", true, &VEIL__R_POS, &sharp));
+        q->amplitude = (float)amp, q->sharpness = (float)sharp;
+    }
     return VEIL_OK;
 }
 
@@ -280,70 +304,4 @@ veil_result veil_particles_write(const char* path, const veil_particle* p, size_
     }
     free(tmp);
     return VEIL_OK;
-}
-
-/* ---- fBm value noise --------------------------------------------------- */
-
-/* A 64-bit integer hash of a lattice point (SplitMix64's finaliser). */
-static uint64_t mix64(uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-/* Lattice value in [0, 1), 24 bits: exact as a float. */
-static float lattice(uint64_t key, int64_t x, int64_t y, int64_t z)
-{
-    uint64_t h = mix64(key ^ (uint64_t)x);
-    h = mix64(h ^ (uint64_t)y);
-    h = mix64(h ^ (uint64_t)z);
-    return (float)(h >> 40) * (1.0f / 16777216.0f);
-}
-
-static float lerpf(float a, float b, float t) { return a + (b - a) * t; }
-
-/* Trilinear value noise with a smoothstep fade, in [0, 1). */
-static float value_noise(uint64_t key, const float x[3])
-{
-    int64_t i[3];
-    float t[3];
-    for (int a = 0; a < 3; ++a) {
-        float v = x[a];
-        if (!(v > -1e15f)) v = -1e15f; /* also NaN */
-        if (v > 1e15f) v = 1e15f;
-        float fl = floorf(v);
-        i[a] = (int64_t)fl;
-        float f = v - fl;
-        t[a] = f * f * (3.0f - 2.0f * f);
-    }
-    float c[2][2];
-    for (int dz = 0; dz < 2; ++dz)
-        for (int dy = 0; dy < 2; ++dy)
-            c[dz][dy] = lerpf(lattice(key, i[0], i[1] + dy, i[2] + dz), lattice(key, i[0] + 1, i[1] + dy, i[2] + dz),
-                              t[0]);
-    return lerpf(lerpf(c[0][0], c[0][1], t[1]), lerpf(c[1][0], c[1][1], t[1]), t[2]);
-}
-
-float veil_particles_fbm(uint64_t seed, int octaves, const float x[3])
-{
-    float sum = 0.0f, norm = 0.0f, w = 1.0f, freq = 1.0f;
-    for (int o = 0; o < octaves; ++o) {
-        float y[3] = {x[0] * freq, x[1] * freq, x[2] * freq};
-        sum += w * value_noise(mix64(seed + 0x9E3779B97F4A7C15ull * (uint64_t)(o + 1)), y);
-        norm += w;
-        w *= 0.5f, freq *= 2.0f;
-    }
-    if (!(norm > 0.0f)) return 0.0f;
-    float n = sum / norm;
-    return n < 0.99999994f ? (n > 0.0f ? n : 0.0f) : 0.99999994f;
-}
-
-void veil_particles_modulate(veil_particle* p, size_t n, uint64_t seed, float scale, int octaves, float amount)
-{
-    if (!(amount > 0.0f) || !(scale > 0.0f) || octaves < 1) return;
-    for (size_t i = 0; i < n; ++i) {
-        float x[3] = {p[i].center[0] / scale, p[i].center[1] / scale, p[i].center[2] / scale};
-        p[i].amplitude *= (1.0f - amount) + amount * veil_particles_fbm(seed, octaves, x);
-    }
 }

@@ -10,8 +10,6 @@
  * Both are read and written byte by byte, so files are portable. Every
  * message starts with the file name and, for a bad particle, names its index
  * and field. At most VEIL_SCENE_MAX_PARTICLES particles.
- *
- * Also the fBm value-noise modulation that `veil rbf generate` applies.
  */
 #ifndef VEIL_PARTICLES_H
 #define VEIL_PARTICLES_H
@@ -20,7 +18,7 @@
 #include <stdint.h>
 
 #include "../core/result.h"
-#include "../volume/rbf.h"
+#include "../scene/particle.h"
 
 #define VEIL_PARTICLES_MAGIC "VEILRBF1"
 #define VEIL_PARTICLES_HEADER_BYTES 16u
@@ -40,14 +38,5 @@ veil_result veil_particles_read(const char* path, veil_particle** out, size_t* c
  * is written. */
 veil_result veil_particles_write(const char* path, const veil_particle* p, size_t n, int binary,
                                  veil_error* err);
-
-/* Seeded value-noise fBm in [0, 1) at x: `octaves` octaves (frequency x2,
- * weight x0.5 each), normalised by the sum of the weights. Integer hashing
- * and float arithmetic in a fixed order: the same on every machine. */
-float veil_particles_fbm(uint64_t seed, int octaves, const float x[3]);
-
-/* amplitude *= (1 - amount) + amount * fbm(seed, octaves, center / scale),
- * for each particle; amount in [0, 1], scale > 0. */
-void veil_particles_modulate(veil_particle* p, size_t n, uint64_t seed, float scale, int octaves, float amount);
 
 #endif

@@ -1,124 +1,18 @@
-/* veil — scene files (JSON), parsed into plain structs.
+/* veil — scene files (JSON), parsed into the plain structs of scene/scene.h.
  *
- * The format is documented in docs/scene-format.md. Units: metres, m^-1 for
- * sigma_a/sigma_s (per unit density), W/sr for point- and spot-light intensity, W/m^2
- * for directional irradiance, degrees for the vertical field of view.
- *
- * veil_scene_load() reads a file; every error message starts with the file
- * name, then the JSON path of the offending field (e.g. `lights[1].intensity`)
- * and what was expected. Unknown keys are errors. Relative paths inside the
- * scene resolve against the scene file's folder (scene->base_dir).
- * The scene owns all of its memory; veil_scene_free() releases it.
+ * The format is documented in docs/scene-format.md. veil_scene_load() reads
+ * a file; every error message starts with the file name, then the JSON path
+ * of the offending field (e.g. `lights[1].intensity`) and what was
+ * expected. Unknown keys are errors. Relative paths inside the scene
+ * resolve against the scene file's folder (scene->base_dir).
  */
-#ifndef VEIL_SCENE_H
-#define VEIL_SCENE_H
+#ifndef VEIL_IO_SCENE_H
+#define VEIL_IO_SCENE_H
 
 #include <stddef.h>
 
 #include "../core/result.h"
-#include "../core/shared.glsl.h"
-#include "../volume/rbf.h"
-
-#define VEIL_SCENE_DEFAULT_WIDTH 640
-#define VEIL_SCENE_DEFAULT_HEIGHT 480
-#define VEIL_SCENE_DEFAULT_FOV_Y 45.0f
-#define VEIL_SCENE_DEFAULT_MAX_RES 128
-#define VEIL_SCENE_MAX_IMAGE 16384   /* pixels per side */
-#define VEIL_SCENE_MAX_RESOLUTION 2048 /* voxels per side; GL limit checked later */
-#define VEIL_SCENE_MAX_PARTICLES 10000000u
-
-typedef struct veil_camera {
-    float position[3];
-    float look_at[3];
-    float up[3];      /* default (0,1,0) */
-    float fov_y_deg;  /* vertical field of view, (0,180) */
-    int width, height;
-} veil_camera;
-
-typedef enum veil_phase_type { VEIL_PHASE_ISOTROPIC = 0, VEIL_PHASE_HG = 1 } veil_phase_type;
-
-typedef struct veil_phase {
-    veil_phase_type type;
-    float g; /* HG asymmetry in (-1, 1); 0 for isotropic */
-} veil_phase;
-
-typedef enum veil_source_type {
-    VEIL_SOURCE_RBF = 0,
-    VEIL_SOURCE_RBF_RANDOM = 1,
-    VEIL_SOURCE_VDB = 2,
-    VEIL_SOURCE_EXPONENTIAL = 3
-} veil_source_type;
-
-/* An OpenVDB float grid ({"type":"vdb", ...}). */
-typedef struct veil_vdb_source {
-    char* file;          /* resolved against the scene's folder (owned) */
-    char* grid;          /* grid name, or NULL: "density", else the first float grid (owned) */
-    float density_scale; /* multiplies the grid's values; default 1 */
-    int level_set_to_fog; /* "level_set": "to_fog": convert a level set instead of refusing it */
-} veil_vdb_source;
-
-/* Analytic exponential (height) fog ({"type":"exponential", ...}):
- * density(x) = density * exp(-falloff * <x - origin, direction>) inside the
- * box `bounds` (the stated range that clips the otherwise unbounded fog),
- * 0 outside. Never voxelised: its optical depth is the closed form. */
-typedef struct veil_exp_fog {
-    float density;      /* at the origin plane (unitless density) */
-    float falloff;      /* b, m^-1, >= 0 (0: homogeneous) */
-    float direction[3]; /* n, unit: the density falls off along it */
-    float origin[3];    /* o, m */
-    float bounds[2][3]; /* min and max corner, m */
-} veil_exp_fog;
-
-typedef struct veil_source {
-    veil_source_type type;
-    /* VEIL_SOURCE_RBF: explicit particles (owned) */
-    veil_particle* particles;
-    size_t particle_count;
-    /* VEIL_SOURCE_RBF_RANDOM */
-    veil_rbf_random_desc random;
-    /* VEIL_SOURCE_VDB */
-    veil_vdb_source vdb;
-    /* VEIL_SOURCE_EXPONENTIAL */
-    veil_exp_fog fog;
-} veil_source;
-
-/* The default extent of exponential fog around its origin when the scene
- * gives no bounds: a cube of this half-width (m). */
-#define VEIL_FOG_DEFAULT_HALF_EXTENT 1000.0f
-/* At most VEIL_MAX_FOGS (core/shared.glsl.h) exponential fogs. */
-
-typedef struct veil_medium {
-    float sigma_a[3]; /* m^-1 per unit density, default 0 */
-    float sigma_s[3]; /* m^-1 per unit density */
-    veil_phase phase; /* default isotropic */
-    int max_resolution; /* voxels along the longest side of the EV */
-    veil_source* sources; /* owned */
-    size_t source_count;
-} veil_medium;
-
-/* VEIL_LIGHT_POINT, VEIL_LIGHT_DIRECTIONAL or VEIL_LIGHT_SPOT (core/shared.glsl.h)
- * (the shaders use the same values); at most VEIL_MAX_LIGHTS lights. */
-typedef int veil_light_type;
-
-typedef struct veil_light {
-    veil_light_type type;
-    float position[3];  /* point, spot: m */
-    float direction[3]; /* directional, spot: unit vector in which light travels (spot: its axis) */
-    float color[3];     /* point, spot: intensity W/sr on the axis; directional: irradiance W/m^2 */
-    /* spot: full intensity within inner_angle_deg of the axis, none beyond
-     * outer_angle_deg, veil_spot_falloff() between; 0 <= inner < outer <= 180 */
-    float inner_angle_deg, outer_angle_deg;
-} veil_light;
-
-typedef struct veil_scene {
-    char* path;     /* the file as given (owned) */
-    char* base_dir; /* its folder, for relative paths (owned) */
-    veil_camera camera;
-    veil_medium medium;
-    veil_light* lights; /* owned */
-    size_t light_count;
-    float background[3]; /* linear RGB radiance seen through the medium */
-} veil_scene;
+#include "../scene/scene.h"
 
 /* Parses `path`. On failure *out is left zeroed and err says why:
  * VEIL_ERR_IO (missing/unreadable file), VEIL_ERR_PARSE (JSON syntax, with
@@ -129,12 +23,5 @@ veil_result veil_scene_load(const char* path, veil_scene* out, veil_error* err);
 /* Same, from a string in memory; `name` is used in messages and base_dir. */
 veil_result veil_scene_parse(const char* name, const char* json, size_t len,
                              veil_scene* out, veil_error* err);
-
-void veil_scene_free(veil_scene* s); /* accepts NULL and zeroed scenes */
-
-/* All particles of all RBF sources (explicit and generated), newly
- * allocated into *out (free() it). */
-veil_result veil_scene_particles(const veil_scene* s, veil_particle** out,
-                                 size_t* count, veil_error* err);
 
 #endif

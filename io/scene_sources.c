@@ -3,6 +3,7 @@
  * clouds, OpenVDB grids and analytic exponential fog. Private to io/. */
 #include "scene_sources.h"
 #include "particles.h"
+#include "particles_json.h"
 
 #include <errno.h>
 #include <math.h>
@@ -15,30 +16,6 @@ static const char* const VDB_KEYS[] = {"type", "file", "grid", "density_scale", 
 static const char* const FOG_KEYS[] = {"type", "density", "falloff", "direction", "origin", "bounds", NULL};
 static const char* const RBF_KEYS[] = {"type", "particles", "file", NULL};
 static const char* const RANDOM_KEYS[] = {"type", "count", "seed", "bounds", "radius", "amplitude", NULL};
-static const char* const PARTICLE_KEYS[] = {"center", "amplitude", "sharpness", NULL};
-
-veil_result veil__parse_particle_array(const ctx* c, const cJSON* obj, const jpath* p, veil_particle** out,
-                                      size_t* count)
-{
-    const cJSON* arr, *e;
-    size_t i = 0;
-    TRY(veil__jr_get_container(c, obj, p, true, true, &arr));
-    void* items = NULL;
-    TRY(veil__jr_alloc_items(c, p, arr, sizeof **out, VEIL_SCENE_MAX_PARTICLES, &items, count));
-    *out = items;
-    cJSON_ArrayForEach(e, arr) {
-        const jpath ep = {p, NULL, i};
-        veil_particle* q = &(*out)[i++];
-        double amp, sharp;
-        if (!cJSON_IsObject(e)) return veil__jr_expected(c, &ep, "an object", e);
-        TRY(veil__jr_check_keys(c, e, &ep, PARTICLE_KEYS));
-        TRY(veil__jr_get_floats(c, e, &ep, "center", true, 3, false, q->center));
-        TRY(veil__jr_get_number(c, e, &ep, "amplitude", true, &VEIL__R_NONNEG, &amp));
-        TRY(veil__jr_get_number(c, e, &ep, "sharpness", true, &VEIL__R_POS, &sharp));
-        q->amplitude = (float)amp, q->sharpness = (float)sharp;
-    }
-    return VEIL_OK;
-}
 
 static veil_result parse_particles(const ctx* c, const cJSON* so, const jpath* sp, veil_source* src)
 {

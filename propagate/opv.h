@@ -32,7 +32,7 @@
 
 #include "../core/result.h"
 #include "../core/shared.glsl.h"
-#include "../io/scene.h"
+#include "../scene/scene.h"
 #include "../volume/volume.h"
 
 typedef enum veil_opv_method {

@@ -1,19 +1,14 @@
 #include "opv_gpu.h"
 
-#include "../render/gl_util.h"
+#include "../gpu/gl_util.h"
+#include "../gpu/programs.h"
 #include "opv_plan.h"
-
-/* Work group of propagate_sweep.comp (1D). */
-#define VEIL__SWEEP_GROUP 128
 
 veil_result veil_opv_programs_create(veil_opv_programs* p, veil_error* err)
 {
     p->jacobi = p->sweep = 0;
-    veil_result r = veil_gl_compute_program("propagate/shaders/propagate_jacobi.comp",
-                                            veil_shader_propagate_jacobi_comp, &p->jacobi, err);
-    if (r == VEIL_OK)
-        r = veil_gl_compute_program("propagate/shaders/propagate_sweep.comp", veil_shader_propagate_sweep_comp,
-                                    &p->sweep, err);
+    veil_result r = veil_gpu_program("propagate/shaders/propagate_jacobi.comp", &p->jacobi, err);
+    if (r == VEIL_OK) r = veil_gpu_program("propagate/shaders/propagate_sweep.comp", &p->sweep, err);
     if (r != VEIL_OK) veil_opv_programs_destroy(p);
     return r;
 }
@@ -125,7 +120,7 @@ static void dispatch_boxes(GLuint prog, int mode, const veil__box* boxes, int co
     glProgramUniform1i(prog, loc(prog, "u_mode"), mode);
     glProgramUniform3iv(prog, loc(prog, "u_box_lo"), count, lo);
     glProgramUniform3iv(prog, loc(prog, "u_box_n"), count, n);
-    glDispatchCompute(veil_groups(most, VEIL__SWEEP_GROUP), 1, (GLuint)count);
+    glDispatchCompute(veil_groups(most, VEIL_SWEEP_GROUP), 1, (GLuint)count);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
 }
 
@@ -143,7 +138,7 @@ static int sweep_light(GLuint prog, const veil_grid* g, const veil_opv_light* L,
         glProgramUniform1i(prog, loc(prog, "u_solve"), plan.solve);
         for (int m = plan.first; m <= plan.last; ++m, ++passes) {
             glProgramUniform1i(prog, loc(prog, "u_shell"), m);
-            glDispatchCompute(veil_groups(g->dims[u] * g->dims[w], VEIL__SWEEP_GROUP), 1, 1);
+            glDispatchCompute(veil_groups(g->dims[u] * g->dims[w], VEIL_SWEEP_GROUP), 1, 1);
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         }
         return passes;

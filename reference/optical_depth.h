@@ -27,7 +27,7 @@
 #ifndef VEIL_REFERENCE_OPTICAL_DEPTH_H
 #define VEIL_REFERENCE_OPTICAL_DEPTH_H
 
-#include "../io/scene.h"
+#include "../scene/scene.h"
 #include "../volume/volume.h"
 
 /* Density of the medium at world position x: 0 outside the closed box of the centres,

@@ -11,7 +11,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "../render/camera.h"
+#include "../scene/camera.h"
 #include "pt_internal.h"
 
 /* Russian roulette on the path length: from this vertex on a path goes on
@@ -165,12 +165,6 @@ static void trace(const pt_job* j, const double o[3], const double d[3], pt_rng*
 
 /* ---- pixels and threads -------------------------------------------------------- */
 
-static uint64_t mix64(uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
 
 static void render_pixel(pt_job* j, int px, int py, pt_counters* c, uint64_t* dropped)
 {
@@ -183,7 +177,7 @@ static void render_pixel(pt_job* j, int px, int py, pt_counters* c, uint64_t* dr
         n += d[k] * d[k];
     }
     for (int k = 0; k < 3; ++k) d[k] /= sqrt(n);
-    pt_rng rng = {mix64(j->o->seed * 0x9e3779b97f4a7c15ull + mix64((uint64_t)py * (uint64_t)j->w + (uint64_t)px))};
+    pt_rng rng = {veil_mix64(j->o->seed * VEIL_RNG_GAMMA + veil_mix64((uint64_t)py * (uint64_t)j->w + (uint64_t)px))};
     /* Welford's running mean and sum of squared deviations, per channel and for T */
     double mean[4] = {0, 0, 0, 0}, m2[3] = {0, 0, 0};
     int count = 0;

@@ -67,7 +67,7 @@
 #include <stdint.h>
 
 #include "../core/result.h"
-#include "../io/scene.h"
+#include "../scene/scene.h"
 #include "../volume/volume.h"
 
 #define VEIL_PT_MAJORANT_BLOCK 4

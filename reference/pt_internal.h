@@ -10,6 +10,7 @@
 #include <stdint.h>
 
 #include "pathtracer.h"
+#include "../core/rng.h"
 
 typedef struct pt_fog {
     double rho0, falloff;  /* density at the origin plane; b (m^-1) */
@@ -30,21 +31,13 @@ struct veil_pt_medium {
     double sigma_max;      /* largest sigma_t channel (m^-1 per unit density) */
 };
 
-/* A per-pixel random stream (SplitMix64). */
+/* A per-pixel random stream (core/rng.h). */
 typedef struct pt_rng {
     uint64_t s;
 } pt_rng;
 
-static inline uint64_t pt_next(pt_rng* r)
-{
-    uint64_t z = (r->s += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
 /* Uniform in [0, 1). */
-static inline double pt_uniform(pt_rng* r) { return (double)(pt_next(r) >> 11) * 0x1.0p-53; }
+static inline double pt_uniform(pt_rng* r) { return veil_rng_double53(&r->s); }
 
 /* Counters of one thread's walks. */
 typedef struct pt_counters {

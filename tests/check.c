@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/gl_context.h"
+#include "gpu/gl_context.h"
 
 int check_passed, check_failed;
 

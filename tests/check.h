@@ -10,7 +10,7 @@
 
 #include <stdio.h>
 
-#include "render/gl_context.h"
+#include "gpu/gl_context.h"
 
 extern int check_passed, check_failed;
 

@@ -4,9 +4,9 @@
 #include <string.h>
 
 #include "check.h"
-#include "render/gl_context.h"
-#include "render/gl_util.h"
-#include "render/renderer.h"
+#include "gpu/gl_context.h"
+#include "gpu/gl_util.h"
+#include "frame/renderer.h"
 
 int main(void)
 {

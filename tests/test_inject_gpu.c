@@ -13,7 +13,7 @@
 #include <stdlib.h>
 
 #include "check.h"
-#include "render/renderer.h"
+#include "frame/renderer.h"
 
 int main(void)
 {

@@ -42,7 +42,7 @@
 #include "check.h"
 #include "reference/closed_forms.h"
 #include "reference/optical_depth.h"
-#include "render/renderer.h"
+#include "frame/renderer.h"
 #include "test_airlight.h"
 #include "test_scene_util.h"
 #include "volume/scene_volume.h"

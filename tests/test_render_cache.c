@@ -17,7 +17,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "render/renderer.h"
+#include "frame/renderer.h"
 
 static veil_particle parts[3] = {
     {.center = {0.0f, 0.0f, 0.0f}, .amplitude = 1.0f, .sharpness = 3.0f},

@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "io/scene.h"
-#include "render/camera.h"
+#include "scene/camera.h"
 
 /* Parses json or exits 1 (the test's own scene must be valid). */
 static inline veil_scene test_parse_scene(const char* json)

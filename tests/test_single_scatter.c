@@ -30,8 +30,8 @@
 #include <stdlib.h>
 
 #include "check.h"
-#include "render/camera.h"
-#include "render/renderer.h"
+#include "scene/camera.h"
+#include "frame/renderer.h"
 
 static double hg(double c, double g) { return (1 - g * g) / (4 * VEIL_PI * pow(1 + g * g - 2 * g * c, 1.5)); }
 

@@ -47,8 +47,8 @@
 #include "propagate/opv.h"
 #include "reference/optical_depth.h"
 #include "reference/pathtracer.h"
-#include "render/gl_util.h"
-#include "render/renderer.h"
+#include "gpu/gl_util.h"
+#include "frame/renderer.h"
 #include "test_random.h"
 #include "volume/scene_volume.h"
 

@@ -1,6 +1,6 @@
 #include "inject_gpu.h"
 
-#include "../render/gl_util.h"
+#include "../gpu/gl_util.h"
 
 veil_result veil_inject_rbf_gpu(GLuint program, const veil_grid* g, const veil_rbf_bins* b,
                                 GLuint ev_texture, veil_error* err)

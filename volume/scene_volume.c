@@ -26,8 +26,7 @@ static void grow(float lo[3], float hi[3], int* any, const float a[3], const flo
     *any = 1;
 }
 
-/* Opens source i's grid and mixes its identity (path, chosen grid, size and
- * modification time, scale, level-set mode; not its bytes) into the key. */
+/* Opens source i's grid and grows [lo, hi] by its support. */
 static veil_result open_vdb(veil_scene_volume* v, const veil_source* src, size_t i, float lo[3], float hi[3],
                             int* any, veil_error* err)
 {
@@ -35,23 +34,12 @@ static veil_result open_vdb(veil_scene_volume* v, const veil_source* src, size_t
         return veil_fail(err, VEIL_ERR_LIMIT, "medium.sources[%zu]: at most %d vdb sources", i, VEIL_MAX_VDB_SOURCES);
     char chosen[256];
     veil_vdb* vdb = NULL;
+    veil_error inner = {{0}};
     veil_result r = veil_vdb_open(src->vdb.file, src->vdb.grid, src->vdb.level_set_to_fog, &vdb, chosen,
-                                  sizeof chosen, err);
-    if (r != VEIL_OK) {
-        veil_error inner = *err;
-        return veil_fail(err, r, "medium.sources[%zu]: %.1900s", i, inner.msg);
-    }
+                                  sizeof chosen, &inner);
+    if (r != VEIL_OK) return veil_fail(err, r, "medium.sources[%zu]: %.1900s", i, inner.msg);
     v->vdbs[v->vdb_count] = vdb;
     v->vdb_scale[v->vdb_count++] = src->vdb.density_scale;
-    struct stat sb;
-    memset(&sb, 0, sizeof sb);
-    stat(src->vdb.file, &sb);
-    uint64_t k = veil_hash_bytes(v->key, src->vdb.file, strlen(src->vdb.file));
-    k = veil_hash_bytes(k, chosen, strlen(chosen));
-    k = veil_hash_bytes(k, &sb.st_size, sizeof sb.st_size);
-    k = veil_hash_bytes(k, &sb.st_mtim, sizeof sb.st_mtim);
-    k = veil_hash_bytes(k, &src->vdb.density_scale, sizeof src->vdb.density_scale);
-    v->key = veil_hash_bytes(k, &src->vdb.level_set_to_fog, sizeof src->vdb.level_set_to_fog);
     int ilo[3], ihi[3];
     size_t active = 0;
     r = veil_vdb_index_bbox(vdb, ilo, ihi, &active);
@@ -64,19 +52,70 @@ static veil_result open_vdb(veil_scene_volume* v, const veil_source* src, size_t
     return r;
 }
 
+/* A file's identity: its path, size, modification time and inode, not
+ * its bytes (a file rewritten in place changes its mtime). A file that
+ * cannot be stat'ed keys as such; opening it reports the error. */
+static uint64_t hash_file_identity(uint64_t k, const char* path)
+{
+    struct stat sb;
+    memset(&sb, 0, sizeof sb);
+    int ok = stat(path, &sb) == 0;
+    k = veil_hash_bytes(k, path, strlen(path) + 1);
+    k = veil_hash_bytes(k, &ok, sizeof ok);
+    if (!ok) return k;
+    int64_t id[5] = {(int64_t)sb.st_size, (int64_t)sb.st_mtim.tv_sec, (int64_t)sb.st_mtim.tv_nsec,
+                     (int64_t)sb.st_ino, (int64_t)sb.st_dev};
+    return veil_hash_bytes(k, id, sizeof id);
+}
+
+uint64_t veil_scene_volume_key(const veil_scene* s)
+{
+    uint64_t k = veil_hash_bytes(VEIL_FNV_OFFSET, &s->medium.max_resolution, sizeof s->medium.max_resolution);
+    for (size_t i = 0; i < s->medium.source_count; ++i) {
+        const veil_source* src = &s->medium.sources[i];
+        if (src->type == VEIL_SOURCE_EXPONENTIAL) continue; /* never voxelised */
+        int type = (int)src->type;
+        k = veil_hash_bytes(k, &type, sizeof type);
+        if (src->type == VEIL_SOURCE_RBF) {
+            k = veil_hash_bytes(k, &src->particle_count, sizeof src->particle_count);
+            k = veil_hash_bytes(k, src->particles, src->particle_count * sizeof *src->particles);
+        } else if (src->type == VEIL_SOURCE_RBF_RANDOM) {
+            const veil_rbf_random_desc* d = &src->random;
+            k = veil_hash_bytes(k, &d->count, sizeof d->count);
+            k = veil_hash_bytes(k, &d->seed, sizeof d->seed);
+            k = veil_hash_bytes(k, d->bounds, sizeof d->bounds);
+            k = veil_hash_bytes(k, d->radius, sizeof d->radius);
+            k = veil_hash_bytes(k, d->amplitude, sizeof d->amplitude);
+        } else if (src->type == VEIL_SOURCE_VDB) {
+            const char* grid = src->vdb.grid ? src->vdb.grid : "";
+            k = hash_file_identity(k, src->vdb.file);
+            k = veil_hash_bytes(k, grid, strlen(grid) + 1);
+            k = veil_hash_bytes(k, &src->vdb.density_scale, sizeof src->vdb.density_scale);
+            k = veil_hash_bytes(k, &src->vdb.level_set_to_fog, sizeof src->vdb.level_set_to_fog);
+        }
+    }
+    return k;
+}
+
+int veil_scene_volume_needed(const veil_scene* s)
+{
+    for (size_t i = 0; i < s->medium.source_count; ++i)
+        if (s->medium.sources[i].type != VEIL_SOURCE_EXPONENTIAL) return 1;
+    return 0;
+}
+
 veil_result veil_scene_volume_open(const veil_scene* s, veil_scene_volume* out, veil_error* err)
 {
     veil_scene_volume v;
     memset(&v, 0, sizeof v);
-    v.key = veil_hash_bytes(VEIL_FNV_OFFSET, &s->medium.max_resolution, sizeof s->medium.max_resolution);
     memset(out, 0, sizeof *out);
+    v.key = veil_scene_volume_key(s);
     veil_result r = veil_scene_particles(s, &v.particles, &v.particle_count, err);
     float lo[3], hi[3], a[3], b[3];
     int any = 0;
     for (size_t i = 0; i < s->medium.source_count && r == VEIL_OK; ++i)
         if (s->medium.sources[i].type == VEIL_SOURCE_VDB) r = open_vdb(&v, &s->medium.sources[i], i, lo, hi, &any, err);
     if (r == VEIL_OK) {
-        v.key = veil_hash_bytes(v.key, v.particles, v.particle_count * sizeof *v.particles);
         if (veil_rbf_bounds(v.particles, v.particle_count, a, b)) grow(lo, hi, &any, a, b);
         if (any) r = veil_grid_fit(lo, hi, s->medium.max_resolution, &v.grid, err);
         v.has_volume = any;

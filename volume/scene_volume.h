@@ -18,7 +18,7 @@
 #include <stdint.h>
 
 #include "../core/result.h"
-#include "../io/scene.h"
+#include "../scene/scene.h"
 #include "../io/vdb.h"
 #include "volume.h"
 
@@ -32,10 +32,22 @@ typedef struct veil_scene_volume {
     float vdb_scale[VEIL_MAX_VDB_SOURCES]; /* their density_scale */
     int vdb_count;
     size_t vdb_voxels; /* active voxels over all grids */
-    uint64_t key;      /* content key: resolution, particles, grid files' identities */
+    uint64_t key;      /* veil_scene_volume_key() of the scene */
     int has_volume;    /* 0: nothing to voxelise (then `grid` is unset) */
     veil_grid grid;
 } veil_scene_volume;
+
+/* The key of the volume a scene's sources make, from their descriptions
+ * alone: the resolution, explicit particles, the random generators'
+ * parameters, each VDB file's identity (path, size, modification time,
+ * inode; never its bytes), grid name, scale and level-set mode. Nothing is
+ * opened, so a cached volume is recognised in microseconds whatever the
+ * files' sizes. Analytic fog is not part of it (never voxelised). */
+uint64_t veil_scene_volume_key(const veil_scene* s);
+
+/* 0 when no source of the scene is voxelised (fog only, or no source):
+ * then there is nothing to open. */
+int veil_scene_volume_needed(const veil_scene* s);
 
 /* Errors name the source (`medium.sources[i]: ...`). On failure *out is
  * left closed (nothing to free). */

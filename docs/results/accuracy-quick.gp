@@ -14,60 +14,58 @@ set ylabel 'error against the reference (single scattering): rel_rmse per pixel'
 set key outside right top noenhanced samplen 2
 set format y '%g'
 $all0 << EOD
-42.37 0.00749812 "res=32"
-213.5 0.00747222 "res=64"
-262.7 0.00747255 "step=1+res=64"
-576.8 0.0230809 "res=32+jacobi-corrected"
-1446 0.00746962 "step=0.25"
-1478 0.00746966 "step=1"
-1615 0.00746739 "step=4"
-1817 0.00746956 "default"
-3029 0.0100478 "sweep"
+13.19 0.00749812 "res=32"
+86.85 0.0230809 "res=32+jacobi-corrected"
+89.54 0.00747255 "step=1+res=64"
+102.8 0.00747222 "res=64"
+388.3 0.00746739 "step=4"
+417.6 0.00746966 "step=1"
+452.2 0.00746962 "step=0.25"
+464.9 0.00746956 "default"
+605.1 0.0100478 "sweep"
 EOD
 $front0 << EOD
-42.37 0.00749812 "res=32"
+13.19 0.00749812 "res=32"
 EOD
 $default0 << EOD
-1817 0.00746956
+464.9 0.00746956
 EOD
 $all1 << EOD
-249.6 0.335718 "res=32+jacobi-corrected"
-518.8 0.0907123 "step=1+res=64"
-625 0.0902574 "res=64"
-671.2 0.168615 "res=32"
-2242 0.0818365 "step=0.25"
-2271 0.0816903 "step=1"
-2335 0.0818621 "step=4"
-2479 0.0818457 "default"
-2499 0.145267 "sweep"
+77.76 0.168615 "res=32"
+138.3 0.335718 "res=32+jacobi-corrected"
+162.3 0.0907123 "step=1+res=64"
+385.3 0.0902574 "res=64"
+536.7 0.0816903 "step=1"
+548 0.0818621 "step=4"
+582.8 0.0818365 "step=0.25"
+589.1 0.0818457 "default"
+638.4 0.145267 "sweep"
 EOD
 $front1 << EOD
-249.6 0.335718 "res=32+jacobi-corrected"
-518.8 0.0907123 "step=1+res=64"
-2242 0.0818365 "step=0.25"
+77.76 0.168615 "res=32"
+162.3 0.0907123 "step=1+res=64"
+536.7 0.0816903 "step=1"
 EOD
 $default1 << EOD
-2479 0.0818457
+589.1 0.0818457
 EOD
 $all2 << EOD
-1269 0.0346583 "res=32"
-1428 0.0374126 "res=32+jacobi-corrected"
-1530 0.0135845 "step=1+res=64"
-1595 0.0137228 "res=64"
-1745 0.0089497 "step=4"
-1824 0.00861305 "step=1"
-1904 0.00861355 "default"
-1943 0.00861421 "step=0.25"
-2304 0.00974852 "sweep"
+290.5 0.0135845 "step=1+res=64"
+300 0.0137228 "res=64"
+302.3 0.0374126 "res=32+jacobi-corrected"
+359.4 0.0346583 "res=32"
+386.6 0.00861355 "default"
+388.5 0.00861305 "step=1"
+393.5 0.00861421 "step=0.25"
+401.5 0.00894971 "step=4"
+494 0.00974852 "sweep"
 EOD
 $front2 << EOD
-1269 0.0346583 "res=32"
-1530 0.0135845 "step=1+res=64"
-1745 0.0089497 "step=4"
-1824 0.00861305 "step=1"
+290.5 0.0135845 "step=1+res=64"
+386.6 0.00861355 "default"
 EOD
 $default2 << EOD
-1904 0.00861355
+386.6 0.00861355
 EOD
 plot \
   NaN with lines lw 2 lc rgb 'black' title 'Pareto front', \

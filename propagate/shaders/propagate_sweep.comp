@@ -8,7 +8,7 @@
 //  u_mode 1: semi-Lagrangian near field: box 0, direct integration.
 //  u_mode 2: semi-Lagrangian boxes (shell sub-pass or sun slice): the
 //            voxels of box gl_WorkGroupID.z, flattened x fastest.
-layout(local_size_x = 128) in;
+layout(local_size_x = VEIL_SWEEP_GROUP) in;
 
 layout(binding = VEIL_IMAGE_EV, r32f) readonly uniform image3D u_ev;
 layout(binding = VEIL_IMAGE_OPV_DST, rgba32f) uniform image3D u_opv;

@@ -41,3 +41,26 @@ void veil_camera_ray(const veil_camera_basis* b, int width, int height, int px, 
     n = sqrtf(n);
     for (int a = 0; a < 3; ++a) dir[a] /= n;
 }
+
+veil_camera veil_camera_orbit(const veil_camera* c, double angle)
+{
+    veil_camera o = *c;
+    double u[3], v[3], len = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        u[a] = c->up[a];
+        len += u[a] * u[a];
+        v[a] = (double)c->position[a] - c->look_at[a];
+    }
+    len = sqrt(len);
+    for (int a = 0; a < 3; ++a) u[a] /= len;
+    double cs = cos(angle), sn = sin(angle), uv = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    double x[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    for (int a = 0; a < 3; ++a)
+        o.position[a] = (float)(c->look_at[a] + v[a] * cs + x[a] * sn + u[a] * uv * (1.0 - cs));
+    return o;
+}
+
+veil_camera veil_camera_of_frame(const veil_camera* c, long frame, long frames)
+{
+    return veil_camera_orbit(c, frames > 1 ? 2.0 * VEIL_PI * (double)frame / (double)frames : 0.0);
+}

@@ -1,21 +1,23 @@
-/* veil — the renderer: runs the pipeline of a scene on the GPU.
+/* veil — the renderer: runs a scene's pipeline on the GPU, frame after
+ * frame, doing only the work a frame needs.
  *
- *   particles --inject--> extinction volume (density, r32f 3D texture)
- *             --propagate--> optical-depth volumes (rgba32f, 4 lights each)
- *             --march--> linear RGBA image (rgb radiance, a = 1 - mean T)
+ *   sources --inject--> extinction volume (volume/ev.h)
+ *           --propagate--> optical-depth volumes (propagate/opv_set.h)
+ *           --march--> image set (render/march.h, render/image_set.h)
  *
- * A renderer owns its compute programs and needs the veil_gl context that
- * was current when it was created. Images are returned as newly malloc'd
- * float RGBA, top row first (free() them).
+ * Each stage has one shape (frame/stage.h): its key is computed from
+ * descriptions — the inject key from the sources' descriptions and the VDB
+ * files' identities (volume/scene_volume.h: no file is opened to form it),
+ * each OPV texture's key from the inject key, the method and its lights'
+ * geometry (not their colour) — and a frame whose keys match what the
+ * renderer keeps reuses it (a turntable: only the camera moves, so inject
+ * and propagate run once). Lights that add nothing (zero colour, or a spot
+ * whose cone misses the volume) get no OPV and are not marched; an empty
+ * medium makes no EV and no OPV. The stats carry each stage's report.
  *
- * Work a frame does not need is skipped: the EV is kept with a key of the
- * content it was made from (resolution and particles, or the given
- * density), and each OPV texture with a key of the EV, the method and its
- * lights' positions; a later render whose inputs have the same keys (a
- * turntable: only the camera moves) reuses them, and the stats say
- * "cached". Lights that add nothing (zero colour, or a spot whose cone
- * misses the volume) get no OPV and are not marched; an empty medium
- * makes no EV and no OPV.
+ * A renderer needs the veil_gl context that was current when it was
+ * created (its memory budget bounds the volumes). Returned buffers are
+ * malloc'd, top row first.
  */
 #ifndef VEIL_RENDERER_H
 #define VEIL_RENDERER_H
@@ -23,31 +25,25 @@
 #include <stdint.h>
 
 #include "../core/result.h"
-#include "../io/scene.h"
+#include "../gpu/gl_context.h"
 #include "../propagate/opv.h"
+#include "../render/image_set.h"
+#include "../render/march.h"
+#include "../scene/scene.h"
 #include "../volume/scene_volume.h"
 #include "../volume/volume.h"
-#include "gl_context.h"
-
-/* Ray-march step as a fraction of the voxel edge. Half a voxel resolves the
- * trilinear medium between centres; the step error is measured, not assumed. */
-#define VEIL_DEFAULT_STEP_VOXELS 0.5f
+#include "stage.h"
 
 /* Jacobi stops when a checked step changes no optical depth sigma_t * D by
  * more than this (unitless): well under the 8-bit resolution of a preview. */
 #define VEIL_OPV_TAU_TOLERANCE 1e-4f
 
-/* The smallest march step through fog when there is no volume (m). */
-#define VEIL_FOG_MIN_STEP 0.01f
-
-/* Point lights closer than this fraction of a voxel count as this far (the
- * 1/r^2 singularity is integrable in the continuum but not in samples). */
-#define VEIL_MIN_LIGHT_DISTANCE_VOXELS 1e-3f
-
 typedef struct veil_renderer veil_renderer;
 
+/* Zero means "default" in every field; veil_render_opts_resolve() says
+ * what zero resolves to. */
 typedef struct veil_render_opts {
-    int width, height;      /* 0: the scene camera's */
+    int width, height;      /* 0: the camera's */
     float step_voxels;      /* 0: VEIL_DEFAULT_STEP_VOXELS */
     uint32_t seed;          /* jitter seed */
     veil_opv_method method; /* 0: VEIL_OPV_DEFAULT_METHOD */
@@ -60,8 +56,14 @@ typedef struct veil_render_opts {
     float max_distance;
 } veil_render_opts;
 
+/* opts (NULL: all defaults) with every zero replaced by what it means for
+ * scene s: the one place defaults are resolved. */
+veil_render_opts veil_render_opts_resolve(const veil_render_opts* opts, const veil_scene* s);
+
 typedef struct veil_render_stats {
-    double inject_ms, propagate_ms, render_ms; /* wall time, GPU work finished */
+    veil_stage_report stage[VEIL_STAGE_COUNT];
+    double inject_ms, propagate_ms, render_ms; /* = stage[...].ms */
+    int width, height;    /* the image's size */
     int has_volume;       /* 0: nothing to inject (empty medium) */
     int inject_cached;    /* the EV was reused */
     veil_grid grid;       /* the EV's geometry when has_volume */
@@ -77,20 +79,29 @@ typedef struct veil_render_stats {
 veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_error* err);
 void veil_renderer_destroy(veil_renderer* r); /* accepts NULL */
 
-/* gl: the current context (its memory budget bounds the volumes). */
+/* The whole pipeline for a scene, into an image set (*images is freed
+ * first; stats may be NULL). */
+veil_result veil_render_scene_images(veil_renderer* r, const veil_scene* s, const veil_render_opts* opts,
+                                     veil_image_set* images, veil_render_stats* stats, veil_error* err);
 
-/* The whole pipeline for a scene. */
+/* The same, keeping only the radiance and alpha (*rgba: width*height*4 floats). */
 veil_result veil_render_scene(veil_renderer* r, const veil_scene* s, const veil_render_opts* opts,
                               float** rgba, veil_render_stats* stats, veil_error* err);
 
 /* Same, with the density given on a grid instead of injected from the
- * scene's sources (tests, and later other sources). */
+ * scene's sources (tests, and later other sources); its inject key hashes
+ * the grid and the density. */
 veil_result veil_render_density(veil_renderer* r, const veil_scene* s, const veil_grid* g,
                                 const float* density, const veil_render_opts* opts, float** rgba,
                                 veil_render_stats* stats, veil_error* err);
 
+/* The lights of s that add light inside the box of g (NULL: fog only, no
+ * box), in scene order, into out (VEIL_MAX_LIGHTS): zero colour never
+ * does; a spot whose outer cone misses the box's bounding sphere does not. */
+int veil_render_lights(const veil_scene* s, const veil_grid* g, veil_light* out);
+
 /* Stage access for tests: GPU splat read back (veil_grid_voxels floats) and
- * GPU Jacobi read back (n_lights * voxels floats, light-major). */
+ * GPU propagation read back (n_lights * voxels floats, light-major). */
 veil_result veil_renderer_inject(veil_renderer* r, const veil_grid* g, const veil_particle* p, size_t n,
                                  float* density, veil_error* err);
 veil_result veil_renderer_propagate(veil_renderer* r, const veil_grid* g, const float* density,

@@ -9,21 +9,15 @@
 #include <epoxy/gl.h>
 #include <stddef.h>
 
+#include "../core/clock.h"
 #include "../core/result.h"
-
-/* Embedded sources (generated at build time from the files of the same name). */
-extern const char veil_shader_shared_glsl_h[];
-extern const char veil_shader_inject_rbf_comp[];
-extern const char veil_shader_propagate_jacobi_comp[];
-extern const char veil_shader_propagate_sweep_comp[];
-extern const char veil_shader_opv_schemes_glsl_h[];
-extern const char veil_shader_march_comp[];
-extern const char veil_shader_occupancy_comp[];
 
 /* Compiles and links a compute program: "#version 450", VEIL_GLSL, the
  * shared header, then `source`, where a line `//@include NAME` is replaced
- * by the embedded header NAME (only propagate/opv_schemes.glsl.h). `file` (e.g. "render/shaders/march.comp")
- * names the shader in errors and in the object label. */
+ * by the embedded file NAME (gpu/programs.h; one include per shader).
+ * `file` (e.g. "render/shaders/march.comp") names the shader in errors and
+ * in the object label. Stages use veil_gpu_program(); this is for shaders
+ * that are not files (tests, benchmarks). */
 veil_result veil_gl_compute_program(const char* file, const char* source, GLuint* out, veil_error* err);
 
 /* 3D texture with immutable storage, linear filtering, clamp to edge. */
@@ -34,14 +28,16 @@ veil_result veil_gl_texture3d(GLenum internal_format, const int dims[3], const c
 veil_result veil_gl_buffer(const void* data, size_t bytes, GLbitfield flags, const char* label,
                            GLuint* out, veil_error* err);
 
+/* Reads level 0 of a texture back as `floats` floats of `format`
+ * (GL_RED, GL_RGBA); `what` names it in errors. */
+veil_result veil_gl_read_texture(GLuint tex, GLenum format, size_t floats, float* out, const char* what,
+                                 veil_error* err);
+
 /* VEIL_ERR_GPU naming `what` when glGetError() reports an error (e.g. an
  * allocation the driver refused); VEIL_OK otherwise. */
 veil_result veil_gl_check(const char* what, veil_error* err);
 
 /* Ceiling division for dispatch sizes. */
 static inline GLuint veil_groups(int n, int group) { return (GLuint)((n + group - 1) / group); }
-
-/* Monotonic wall clock in milliseconds. */
-double veil_now_ms(void);
 
 #endif

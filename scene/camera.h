@@ -3,12 +3,12 @@
  * normalize(fwd + sx * right + sy * up) with sx = 2 (px + 0.5) / W - 1 and
  * sy = 1 - 2 (py + 0.5) / H, where right and up are scaled by
  * tan(fov_y / 2) (right also by the aspect W / H). render/shaders/march.comp
- * uses the same formula. */
+ * uses the same formula. Also the turntable's camera of frame f. */
 #ifndef VEIL_CAMERA_H
 #define VEIL_CAMERA_H
 
 #include "../core/result.h"
-#include "../io/scene.h"
+#include "scene.h"
 
 typedef struct veil_camera_basis {
     float pos[3], fwd[3], right[3], up[3];
@@ -16,6 +16,15 @@ typedef struct veil_camera_basis {
 
 veil_result veil_camera_make_basis(const veil_camera* c, int width, int height, veil_camera_basis* out,
                                    veil_error* err);
+/* The camera turned by `angle` radians about its up axis through look_at:
+ * the position moves on a circle, look_at, up and the lens stay. */
+veil_camera veil_camera_orbit(const veil_camera* c, double angle);
+
+/* The camera of frame f (0-based) of an n-frame turntable: one full turn in
+ * n equal steps, frame 0 the scene's own camera. A pure function of
+ * (c, f, n): any process rendering frame f sees the same camera. */
+veil_camera veil_camera_of_frame(const veil_camera* c, long frame, long frames);
+
 void veil_camera_ray(const veil_camera_basis* b, int width, int height, int px, int py, float dir[3]);
 
 #endif

@@ -1,17 +1,10 @@
 #define _POSIX_C_SOURCE 200809L
 #include "gl_util.h"
+#include "programs.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-
-double veil_now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
 
 static const char* gl_error_name(GLenum e)
 {
@@ -54,7 +47,7 @@ veil_result veil_gl_compute_program(const char* file, const char* source, GLuint
     *out = 0;
     /* Source strings: 0 = core/shared.glsl.h, 1 = the shader file, 2 = an
      * included header; #line keeps each one's own line numbers in logs. */
-    const char* parts[8] = {"#version 450 core\n#define VEIL_GLSL 1\n#line 1 0\n", veil_shader_shared_glsl_h,
+    const char* parts[8] = {"#version 450 core\n#define VEIL_GLSL 1\n#line 1 0\n", veil_shader_source("core/shared.glsl.h", 0),
                             "\n#line 1 1\n"};
     GLint lens[8] = {-1, -1, -1};
     int n = 3;
@@ -64,9 +57,7 @@ veil_result veil_gl_compute_program(const char* file, const char* source, GLuint
         const char* name = mark + strlen(VEIL__INCLUDE_MARK);
         const char* eol = strchr(name, '\n');
         size_t name_len = eol ? (size_t)(eol - name) : strlen(name);
-        const char* header = NULL;
-        if (name_len == strlen("propagate/opv_schemes.glsl.h") && !strncmp(name, "propagate/opv_schemes.glsl.h", name_len))
-            header = veil_shader_opv_schemes_glsl_h;
+        const char* header = veil_shader_source(name, name_len);
         if (!header)
             return veil_fail(err, VEIL_ERR_SHADER, "%s: unknown include '%.*s'", file, (int)name_len, name);
         int line = 1;
@@ -155,4 +146,14 @@ veil_result veil_gl_buffer(const void* data, size_t bytes, GLbitfield flags, con
         *out = 0;
     }
     return r;
+}
+
+veil_result veil_gl_read_texture(GLuint tex, GLenum format, size_t floats, float* out, const char* what,
+                                 veil_error* err)
+{
+    size_t bytes = floats * sizeof(float);
+    if (bytes > (size_t)INT32_MAX)
+        return veil_fail(err, VEIL_ERR_LIMIT, "%s: %zu bytes is too large to read back", what, bytes);
+    glGetTextureImage(tex, 0, format, GL_FLOAT, (GLsizei)bytes, out);
+    return veil_gl_check(what, err);
 }

@@ -3,7 +3,7 @@
 // around them (the trilinear stencil of any point whose index coordinate u
 // has floor(u) inside the brick reaches one voxel beyond it). 0 means no
 // sample taken in the brick can see any medium: the marcher skips it.
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = VEIL_OCCUPANCY_GROUP, local_size_y = VEIL_OCCUPANCY_GROUP, local_size_z = VEIL_OCCUPANCY_GROUP) in;
 
 layout(binding = VEIL_IMAGE_EV, r32f) readonly uniform image3D u_ev;
 layout(binding = VEIL_IMAGE_OUT, r32f) writeonly uniform image3D u_occ;

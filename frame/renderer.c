@@ -1,0 +1,339 @@
+#include "renderer.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/clock.h"
+#include "../core/hash.h"
+#include "../propagate/opv_set.h"
+#include "../volume/ev.h"
+
+struct veil_renderer {
+    unsigned long long memory_budget; /* bytes, see veil_gl_info */
+    veil_ev* ev;
+    veil_opv_set* opv;
+    veil_march* march;
+    /* what the EV holds: the inject key it was made with (ev_keyed: a key
+     * is held, an empty medium included), and for the report */
+    uint64_t ev_key;
+    int ev_keyed;
+    size_t particles;
+};
+
+/* ---- lifetime ---------------------------------------------------------- */
+
+veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_error* err)
+{
+    *out = NULL;
+    veil_renderer* r = calloc(1, sizeof *r);
+    if (!r) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the renderer");
+    r->memory_budget = veil_gl_get_info(gl)->memory_budget;
+    veil_result res = veil_ev_create(&r->ev, err);
+    if (res == VEIL_OK) res = veil_opv_set_create(&r->opv, err);
+    if (res == VEIL_OK) res = veil_march_create(&r->march, err);
+    if (res != VEIL_OK) {
+        veil_renderer_destroy(r);
+        return res;
+    }
+    *out = r;
+    return VEIL_OK;
+}
+
+void veil_renderer_destroy(veil_renderer* r)
+{
+    if (!r) return;
+    veil_ev_destroy(r->ev);
+    veil_opv_set_destroy(r->opv);
+    veil_march_destroy(r->march);
+    free(r);
+}
+
+/* The EV changed (or is gone): nothing made from it is valid any more. */
+static void forget_volume(veil_renderer* r)
+{
+    veil_ev_clear(r->ev);
+    veil_opv_set_clear(r->opv);
+    r->ev_keyed = 0;
+    r->ev_key = 0;
+    r->particles = 0;
+}
+
+/* ---- planning ---------------------------------------------------------- */
+
+veil_render_opts veil_render_opts_resolve(const veil_render_opts* opts, const veil_scene* s)
+{
+    veil_render_opts o = opts ? *opts : (veil_render_opts){0};
+    if (!o.camera) o.camera = &s->camera;
+    if (o.width <= 0) o.width = o.camera->width;
+    if (o.height <= 0) o.height = o.camera->height;
+    if (!(o.step_voxels > 0.0f)) o.step_voxels = VEIL_DEFAULT_STEP_VOXELS;
+    o.method = veil_opv_method_resolve(o.method);
+    return o;
+}
+
+static int count_fogs(const veil_scene* s)
+{
+    int n = 0;
+    for (size_t i = 0; i < s->medium.source_count; ++i) n += s->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL;
+    return n;
+}
+
+static int light_reaches(const veil_light* l, const veil_grid* g)
+{
+    if (!(l->color[0] > 0.0f || l->color[1] > 0.0f || l->color[2] > 0.0f)) return 0;
+    if (!g || l->type != VEIL_LIGHT_SPOT || l->outer_angle_deg >= 90.0f) return 1;
+    double c[3], d2 = 0.0, r2 = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        double half = 0.5 * g->dims[a] * (double)g->voxel;
+        c[a] = g->origin[a] + half - l->position[a];
+        d2 += c[a] * c[a];
+        r2 += half * half;
+    }
+    if (d2 <= r2) return 1; /* the light is within the sphere */
+    double cos_axis = (c[0] * l->direction[0] + c[1] * l->direction[1] + c[2] * l->direction[2]) / sqrt(d2);
+    double angle = acos(fmax(-1.0, fmin(1.0, cos_axis)));
+    double spread = l->outer_angle_deg * (VEIL_PI / 180.0) + asin(sqrt(r2 / d2));
+    return angle <= spread;
+}
+
+int veil_render_lights(const veil_scene* s, const veil_grid* g, veil_light* out)
+{
+    int n = 0;
+    if (!g && count_fogs(s) == 0) return 0; /* no medium at all */
+    for (size_t l = 0; l < s->light_count && n < VEIL_MAX_LIGHTS; ++l)
+        if (light_reaches(&s->lights[l], g)) out[n++] = s->lights[l];
+    return n;
+}
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+static void why(veil_stage_report* rep, const char* fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(rep->why, sizeof rep->why, fmt, ap);
+    va_end(ap);
+}
+
+/* ---- stage 1: inject --------------------------------------------------- */
+
+static veil_result inject_scene(veil_renderer* r, const veil_scene* s, veil_render_stats* st, veil_error* err)
+{
+    veil_stage_report* rep = &st->stage[VEIL_STAGE_INJECT];
+    uint64_t key = veil_scene_volume_key(s);
+    rep->key = key;
+    if (r->ev_keyed && r->ev_key == key) {
+        rep->status = VEIL_STAGE_CACHED;
+        why(rep, "the sources' descriptions and files are unchanged");
+        st->inject_cached = 1;
+        return VEIL_OK;
+    }
+    int had = r->ev_keyed;
+    forget_volume(r);
+    if (!veil_scene_volume_needed(s)) {
+        rep->status = VEIL_STAGE_SKIPPED;
+        why(rep, "no voxelised source%s", count_fogs(s) ? " (analytic fog only: closed form)" : "");
+        r->ev_keyed = 1, r->ev_key = key; /* an empty medium, remembered as such */
+        return VEIL_OK;
+    }
+    veil_scene_volume v;
+    veil_result res = veil_scene_volume_open(s, &v, err);
+    if (res != VEIL_OK) return res;
+    veil_ev_report er = {0};
+    res = veil_ev_build_scene(r->ev, &v, (int)s->light_count, r->memory_budget, &er, err);
+    if (res == VEIL_OK) {
+        r->ev_keyed = 1, r->ev_key = key;
+        r->particles = er.particles;
+        st->vdb_voxels = er.vdb_voxels;
+        if (!v.has_volume) {
+            rep->status = VEIL_STAGE_SKIPPED;
+            why(rep, "the sources hold no density (no particle, no active voxel)");
+        } else {
+            const veil_grid* g = &v.grid;
+            rep->status = VEIL_STAGE_RAN;
+            why(rep, "%s: %zu particles, %zu VDB voxels, grid %dx%dx%d, voxel %.4g m",
+                had ? "the sources changed" : "no volume kept", er.particles, er.vdb_voxels, g->dims[0], g->dims[1],
+                g->dims[2], g->voxel);
+        }
+    }
+    veil_scene_volume_close(&v);
+    return res;
+}
+
+/* ---- stage 2: propagate ------------------------------------------------ */
+
+static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_light* lights, int n,
+                             const veil_render_opts* o, veil_render_stats* st, veil_error* err)
+{
+    veil_stage_report* rep = &st->stage[VEIL_STAGE_PROPAGATE];
+    const veil_grid* g = veil_ev_grid(r->ev);
+    if (!g) {
+        rep->status = VEIL_STAGE_SKIPPED;
+        why(rep, "no volume: nothing to propagate%s", st->fogs ? " (fog's optical depth is closed form)" : "");
+        return VEIL_OK;
+    }
+    if (n == 0) {
+        rep->status = VEIL_STAGE_SKIPPED;
+        why(rep, "no light reaches the medium (of %zu)", s->light_count);
+        return VEIL_OK;
+    }
+    float st_max = 0.0f;
+    for (int c = 0; c < 3; ++c) st_max = fmaxf(st_max, s->medium.sigma_a[c] + s->medium.sigma_s[c]);
+    /* D changes of tol move tau by at most st_max * tol */
+    veil_opv_params params = {.method = o->method,
+                              .tolerance = st_max > 0.0f ? VEIL_OPV_TAU_TOLERANCE / st_max : INFINITY};
+    veil_opv_report orep = {0};
+    veil_result res = veil_opv_set_update(r->opv, g, veil_ev_texture(r->ev), r->ev_key, lights, n, &params, &orep, err);
+    st->opv_computed = orep.computed;
+    st->opv_cached = orep.cached;
+    st->propagate_iterations = orep.iterations;
+    rep->key = veil_hash_bytes(r->ev_key, &params, sizeof params);
+    for (int l = 0; l < n; ++l) {
+        veil_opv_light ol;
+        veil_opv_light_from_world(g, &lights[l], &ol);
+        rep->key = veil_hash_bytes(rep->key, &ol, sizeof ol);
+    }
+    rep->status = orep.computed ? VEIL_STAGE_RAN : VEIL_STAGE_CACHED;
+    if (orep.computed)
+        why(rep, "%d of %zu lights, %s, %d passes; %d textures computed (volume or light moved), %d cached", n,
+            s->light_count, veil_opv_method_name(o->method), orep.iterations, orep.computed, orep.cached);
+    else
+        why(rep, "%d lights, %s: the volume, method and lights' geometry are unchanged", n,
+            veil_opv_method_name(o->method));
+    return res;
+}
+
+/* ---- stage 3: march, and the frame ------------------------------------- */
+
+static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const veil_render_opts* o,
+                                   veil_image_set* images, veil_render_stats* st, veil_error* err)
+{
+    if (o->width < 1 || o->height < 1 || o->width > VEIL_SCENE_MAX_IMAGE || o->height > VEIL_SCENE_MAX_IMAGE)
+        return veil_fail(err, VEIL_ERR_INVALID, "image size %dx%d is outside 1..%d", o->width, o->height,
+                         VEIL_SCENE_MAX_IMAGE);
+    if (s->light_count > VEIL_MAX_LIGHTS)
+        return veil_fail(err, VEIL_ERR_LIMIT, "%zu lights; at most %d are supported", s->light_count, VEIL_MAX_LIGHTS);
+    const veil_grid* g = veil_ev_grid(r->ev);
+    veil_light lights[VEIL_MAX_LIGHTS];
+    int n = veil_render_lights(s, g, lights);
+    st->fogs = count_fogs(s);
+    st->lights_used = n;
+    st->method = o->method;
+    st->has_volume = g != NULL;
+    if (g) st->grid = *g;
+    st->particles = r->particles;
+    st->width = o->width, st->height = o->height;
+    double t0 = veil_now_ms();
+    veil_result res = propagate(r, s, lights, n, o, st, err);
+    glFinish();
+    double t1 = veil_now_ms();
+    st->stage[VEIL_STAGE_PROPAGATE].ms = t1 - t0;
+    if (res != VEIL_OK) return res;
+    GLuint opv[VEIL_MAX_OPV_TEXTURES];
+    for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) opv[t] = veil_opv_set_texture(r->opv, t);
+    veil_march_desc md = {.scene = s, .camera = o->camera, .width = o->width, .height = o->height,
+                          .lights = lights, .light_count = n, .grid = g,
+                          .ev = veil_ev_texture(r->ev), .occupancy = veil_ev_occupancy(r->ev), .opv = opv,
+                          .step_voxels = o->step_voxels, .seed = o->seed, .skip_empty = !o->no_skip,
+                          .max_distance = o->max_distance};
+    res = veil_march_run(r->march, &md, images, err);
+    veil_stage_report* rep = &st->stage[VEIL_STAGE_MARCH];
+    rep->ms = veil_now_ms() - t1;
+    rep->status = VEIL_STAGE_RAN;
+    why(rep, "%dx%d, %d lights, step %g voxels: depends on the camera, runs every frame", o->width, o->height, n,
+        o->step_voxels);
+    return res;
+}
+
+static void finish_stats(veil_render_stats* st, veil_render_stats* out)
+{
+    st->inject_ms = st->stage[VEIL_STAGE_INJECT].ms;
+    st->propagate_ms = st->stage[VEIL_STAGE_PROPAGATE].ms;
+    st->render_ms = st->stage[VEIL_STAGE_MARCH].ms;
+    if (out) *out = *st;
+}
+
+veil_result veil_render_scene_images(veil_renderer* r, const veil_scene* s, const veil_render_opts* opts,
+                                     veil_image_set* images, veil_render_stats* stats, veil_error* err)
+{
+    veil_render_opts o = veil_render_opts_resolve(opts, s);
+    veil_render_stats st;
+    memset(&st, 0, sizeof st);
+    veil_image_set_free(images);
+    double t0 = veil_now_ms();
+    veil_result res = inject_scene(r, s, &st, err);
+    glFinish();
+    st.stage[VEIL_STAGE_INJECT].ms = veil_now_ms() - t0;
+    if (res == VEIL_OK) res = light_and_march(r, s, &o, images, &st, err);
+    finish_stats(&st, stats);
+    return res;
+}
+
+/* Keeps the radiance buffer of an image set and frees the rest. */
+static float* take_rgba(veil_image_set* im)
+{
+    float* rgba = im->rgba;
+    im->rgba = NULL;
+    veil_image_set_free(im);
+    return rgba;
+}
+
+veil_result veil_render_scene(veil_renderer* r, const veil_scene* s, const veil_render_opts* opts, float** rgba,
+                              veil_render_stats* stats, veil_error* err)
+{
+    veil_image_set im = {0};
+    veil_result res = veil_render_scene_images(r, s, opts, &im, stats, err);
+    *rgba = take_rgba(&im);
+    return res;
+}
+
+veil_result veil_render_density(veil_renderer* r, const veil_scene* s, const veil_grid* g, const float* density,
+                                const veil_render_opts* opts, float** rgba, veil_render_stats* stats,
+                                veil_error* err)
+{
+    veil_render_opts o = veil_render_opts_resolve(opts, s);
+    veil_render_stats st;
+    memset(&st, 0, sizeof st);
+    *rgba = NULL;
+    veil_stage_report* rep = &st.stage[VEIL_STAGE_INJECT];
+    double t0 = veil_now_ms();
+    uint64_t key = veil_hash_bytes(VEIL_FNV_OFFSET, g, sizeof *g);
+    key = veil_hash_bytes(key, density, veil_grid_voxels(g) * sizeof(float));
+    rep->key = key;
+    veil_result res = VEIL_OK;
+    if (r->ev_keyed && veil_ev_present(r->ev) && r->ev_key == key) {
+        st.inject_cached = 1;
+        rep->status = VEIL_STAGE_CACHED;
+        why(rep, "the same density on the same grid");
+    } else {
+        forget_volume(r);
+        res = veil_ev_build_density(r->ev, g, density, (int)s->light_count, r->memory_budget, err);
+        if (res == VEIL_OK) r->ev_keyed = 1, r->ev_key = key;
+        rep->status = VEIL_STAGE_RAN;
+        why(rep, "a density given on a %dx%dx%d grid", g->dims[0], g->dims[1], g->dims[2]);
+    }
+    glFinish();
+    rep->ms = veil_now_ms() - t0;
+    veil_image_set im = {0};
+    if (res == VEIL_OK) res = light_and_march(r, s, &o, &im, &st, err);
+    *rgba = take_rgba(&im);
+    finish_stats(&st, stats);
+    return res;
+}
+
+veil_result veil_renderer_inject(veil_renderer* r, const veil_grid* g, const veil_particle* p, size_t n,
+                                 float* density, veil_error* err)
+{
+    return veil_ev_splat_readback(r->ev, g, p, n, density, err);
+}
+
+veil_result veil_renderer_propagate(veil_renderer* r, const veil_grid* g, const float* density,
+                                    const veil_opv_light* lights, int n_lights, const veil_opv_params* params,
+                                    float* out, int* iterations, veil_error* err)
+{
+    return veil_opv_set_propagate_readback(r->opv, g, density, lights, n_lights, params, out, iterations, err);
+}

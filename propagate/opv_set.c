@@ -1,0 +1,111 @@
+#include "opv_set.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/hash.h"
+#include "../gpu/gl_util.h"
+#include "opv_gpu.h"
+
+struct veil_opv_set {
+    veil_opv_programs programs;
+    GLuint tex[VEIL_MAX_OPV_TEXTURES];
+    uint64_t key[VEIL_MAX_OPV_TEXTURES]; /* 0: none (or being remade) */
+};
+
+veil_result veil_opv_set_create(veil_opv_set** out, veil_error* err)
+{
+    *out = NULL;
+    veil_opv_set* s = calloc(1, sizeof *s);
+    if (!s) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the optical-depth volumes");
+    veil_result r = veil_opv_programs_create(&s->programs, err);
+    if (r != VEIL_OK) {
+        free(s);
+        return r;
+    }
+    *out = s;
+    return VEIL_OK;
+}
+
+void veil_opv_set_clear(veil_opv_set* s)
+{
+    glDeleteTextures(VEIL_MAX_OPV_TEXTURES, s->tex);
+    memset(s->tex, 0, sizeof s->tex);
+    memset(s->key, 0, sizeof s->key);
+}
+
+void veil_opv_set_destroy(veil_opv_set* s)
+{
+    if (!s) return;
+    veil_opv_set_clear(s);
+    veil_opv_programs_destroy(&s->programs);
+    free(s);
+}
+
+GLuint veil_opv_set_texture(const veil_opv_set* s, int t) { return s->tex[t]; }
+
+uint64_t veil_opv_texture_key(uint64_t ev_key, const veil_opv_params* params, const veil_opv_light* lights, int count)
+{
+    uint64_t key = veil_hash_bytes(ev_key, params, sizeof *params);
+    for (int c = 0; c < count; ++c) key = veil_hash_bytes(key, &lights[c], sizeof lights[c]);
+    return key;
+}
+
+int veil_opv_set_has(const veil_opv_set* s, int t, uint64_t key) { return s->tex[t] && s->key[t] == key; }
+
+veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, uint64_t ev_key,
+                                const veil_light* lights, int n, const veil_opv_params* params, veil_opv_report* rep,
+                                veil_error* err)
+{
+    memset(rep, 0, sizeof *rep);
+    veil_result r = VEIL_OK;
+    for (int t = 0; 4 * t < n && r == VEIL_OK; ++t) {
+        int count = n - 4 * t < 4 ? n - 4 * t : 4;
+        veil_opv_light ol[4];
+        for (int c = 0; c < count; ++c) veil_opv_light_from_world(g, &lights[4 * t + c], &ol[c]);
+        uint64_t key = veil_opv_texture_key(ev_key, params, ol, count);
+        if (veil_opv_set_has(s, t, key)) {
+            ++rep->cached;
+            continue;
+        }
+        if (!s->tex[t]) r = veil_gl_texture3d(GL_RGBA32F, g->dims, "veil optical-depth volume", &s->tex[t], err);
+        int it = 0;
+        s->key[t] = 0;
+        if (r == VEIL_OK) r = veil_opv_gpu(&s->programs, g, ev, ol, count, params, &s->tex[t], &it, err);
+        if (r == VEIL_OK) s->key[t] = key;
+        rep->iterations = it > rep->iterations ? it : rep->iterations;
+        ++rep->computed;
+    }
+    return r;
+}
+
+veil_result veil_opv_set_propagate_readback(veil_opv_set* s, const veil_grid* g, const float* density,
+                                            const veil_opv_light* lights, int n_lights,
+                                            const veil_opv_params* params, float* out, int* iterations,
+                                            veil_error* err)
+{
+    if (n_lights < 1 || n_lights > VEIL_MAX_LIGHTS)
+        return veil_fail(err, VEIL_ERR_INVALID, "propagate: %d lights (1..%d)", n_lights, VEIL_MAX_LIGHTS);
+    GLuint ev = 0, opv[VEIL_MAX_OPV_TEXTURES] = {0};
+    int n_tex = (n_lights + 3) / 4;
+    size_t nv = veil_grid_voxels(g);
+    float* tmp = malloc(nv * 4 * sizeof(float));
+    veil_result r = tmp ? veil_gl_texture3d(GL_R32F, g->dims, "veil extinction volume", &ev, err)
+                        : veil_fail(err, VEIL_ERR_OOM, "out of memory");
+    if (r == VEIL_OK) {
+        glTextureSubImage3D(ev, 0, 0, 0, 0, g->dims[0], g->dims[1], g->dims[2], GL_RED, GL_FLOAT, density);
+        r = veil_gl_check("uploading the extinction volume", err);
+    }
+    for (int t = 0; t < n_tex && r == VEIL_OK; ++t)
+        r = veil_gl_texture3d(GL_RGBA32F, g->dims, "veil optical-depth volume", &opv[t], err);
+    if (r == VEIL_OK) r = veil_opv_gpu(&s->programs, g, ev, lights, n_lights, params, opv, iterations, err);
+    for (int t = 0; t < n_tex && r == VEIL_OK; ++t) {
+        r = veil_gl_read_texture(opv[t], GL_RGBA, nv * 4, tmp, "reading back an OPV", err);
+        for (int c = 0; c < 4 && 4 * t + c < n_lights && r == VEIL_OK; ++c)
+            for (size_t v = 0; v < nv; ++v) out[(size_t)(4 * t + c) * nv + v] = tmp[4 * v + c];
+    }
+    glDeleteTextures(1, &ev);
+    glDeleteTextures(VEIL_MAX_OPV_TEXTURES, opv);
+    free(tmp);
+    return r;
+}

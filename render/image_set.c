@@ -1,0 +1,44 @@
+#include "image_set.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "../io/image.h"
+
+const char* const veil_image_set_channel_names[VEIL_IMAGE_SET_CHANNELS] = {
+    "R", "G", "B", "A", "T.R", "T.G", "T.B", "P", "single.R", "single.G", "single.B", "depth"};
+
+void veil_image_set_free(veil_image_set* s)
+{
+    if (!s) return;
+    free(s->rgba);
+    free(s->aov_t);
+    free(s->aov_s);
+    memset(s, 0, sizeof *s);
+}
+
+void veil_image_set_plane(const veil_image_set* s, int c, float* out)
+{
+    const float* src = c < 4 ? s->rgba : c < 8 ? s->aov_t : s->aov_s;
+    size_t n = (size_t)s->width * (size_t)s->height;
+    for (size_t i = 0; i < n; ++i) out[i] = src[4 * i + (size_t)(c % 4)];
+}
+
+veil_result veil_image_set_write_exr(const veil_image_set* s, const char* path, int aovs, veil_error* err)
+{
+    if (!aovs) return veil_write_exr(path, s->width, s->height, s->rgba, err);
+    size_t n = (size_t)s->width * (size_t)s->height, bytes;
+    if (!veil_mul_sizes(n, VEIL_IMAGE_SET_CHANNELS, sizeof(float), 1, &bytes))
+        return veil_fail(err, VEIL_ERR_LIMIT, "%s: a %dx%d image set is too large", path, s->width, s->height);
+    float* all = malloc(bytes);
+    if (!all) return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory for the image set's planes", path);
+    const float* planes[VEIL_IMAGE_SET_CHANNELS];
+    for (int c = 0; c < VEIL_IMAGE_SET_CHANNELS; ++c) {
+        veil_image_set_plane(s, c, all + (size_t)c * n);
+        planes[c] = all + (size_t)c * n;
+    }
+    veil_result r = veil_write_exr_planes(path, s->width, s->height, VEIL_IMAGE_SET_CHANNELS,
+                                          veil_image_set_channel_names, planes, err);
+    free(all);
+    return r;
+}

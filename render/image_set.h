@@ -1,0 +1,44 @@
+/* veil — an image set: what the ray marcher writes for one frame, kept
+ * apart so that a compositor gets each part as a named EXR channel.
+ *
+ * Every buffer is width*height pixels, row-major, top row first, 4 floats a
+ * pixel (malloc'd; the set owns them; veil_image_set_free() releases):
+ *   rgba   R, G, B: linear radiance reaching the camera (the light scattered
+ *          toward it plus the background it sees through the medium);
+ *          A = 1 - mean transmittance (0: nothing in front of the background)
+ *   aov_t  the transmittance T per channel (R, G, B) and P, the density
+ *          integral along the pixel's ray (density m; sigma_t * P is the
+ *          optical depth)
+ *   aov_s  single scattering (R, G, B: the medium's own light, background
+ *          excluded) and depth, the mean distance (m) of the ray's first
+ *          interaction, 0 where the ray meets no medium
+ * Multiple scattering will add its own part here.
+ */
+#ifndef VEIL_IMAGE_SET_H
+#define VEIL_IMAGE_SET_H
+
+#include "../core/result.h"
+
+typedef struct veil_image_set {
+    int width, height;
+    float* rgba;
+    float* aov_t;
+    float* aov_s;
+} veil_image_set;
+
+void veil_image_set_free(veil_image_set* s); /* accepts NULL and zeroed sets */
+
+/* The EXR channels an image set can hold, by name: "R", "G", "B", "A",
+ * "T.R", "T.G", "T.B", "P", "single.R", "single.G", "single.B", "depth". */
+#define VEIL_IMAGE_SET_CHANNELS 12
+extern const char* const veil_image_set_channel_names[VEIL_IMAGE_SET_CHANNELS];
+
+/* The plane of channel c (an index into the names above) into out
+ * (width*height floats). */
+void veil_image_set_plane(const veil_image_set* s, int c, float* out);
+
+/* Writes the set to an EXR: R, G, B, A, plus the AOV channels when aovs is
+ * non-zero. All or nothing, as every writer in io/. */
+veil_result veil_image_set_write_exr(const veil_image_set* s, const char* path, int aovs, veil_error* err);
+
+#endif

@@ -1,0 +1,152 @@
+#include "march.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../gpu/gl_util.h"
+#include "../gpu/programs.h"
+#include "../scene/camera.h"
+
+struct veil_march {
+    GLuint program, ubo;
+};
+
+veil_result veil_march_create(veil_march** out, veil_error* err)
+{
+    *out = NULL;
+    veil_march* m = calloc(1, sizeof *m);
+    if (!m) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the ray marcher");
+    veil_result r = veil_gpu_program("render/shaders/march.comp", &m->program, err);
+    if (r == VEIL_OK)
+        r = veil_gl_buffer(NULL, sizeof(veil_march_block), GL_DYNAMIC_STORAGE_BIT, "veil march block", &m->ubo, err);
+    if (r != VEIL_OK) {
+        veil_march_destroy(m);
+        return r;
+    }
+    *out = m;
+    return VEIL_OK;
+}
+
+void veil_march_destroy(veil_march* m)
+{
+    if (!m) return;
+    glDeleteProgram(m->program);
+    glDeleteBuffers(1, &m->ubo);
+    free(m);
+}
+
+static void set3(float dst[4], const float src[3], float w)
+{
+    dst[0] = src[0], dst[1] = src[1], dst[2] = src[2], dst[3] = w;
+}
+
+void veil_gpu_light_from(const veil_light* l, veil_gpu_light* out)
+{
+    set3(out->position, l->position, (float)l->type);
+    set3(out->direction, l->direction, cosf(l->inner_angle_deg * (float)(VEIL_PI / 180.0)));
+    set3(out->color, l->color, cosf(l->outer_angle_deg * (float)(VEIL_PI / 180.0)));
+}
+
+veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u, veil_error* err)
+{
+    veil_camera_basis cam;
+    veil_result r = veil_camera_make_basis(d->camera, d->width, d->height, &cam, err);
+    if (r != VEIL_OK) return r;
+    memset(u, 0, sizeof *u);
+    const veil_medium* m = &d->scene->medium;
+    set3(u->cam_pos, cam.pos, 0.0f);
+    set3(u->cam_fwd, cam.fwd, 0.0f);
+    set3(u->cam_right, cam.right, 0.0f);
+    set3(u->cam_up, cam.up, 0.0f);
+    for (int c = 0; c < 3; ++c) u->sigma_t[c] = m->sigma_a[c] + m->sigma_s[c];
+    set3(u->sigma_s, m->sigma_s, 0.0f);
+    set3(u->background, d->scene->background, 0.0f);
+    float g = m->phase.type == VEIL_PHASE_HG ? m->phase.g : 0.0f;
+    if (d->grid) {
+        float lo[3], hi[3], inv[3];
+        veil_grid_medium_box(d->grid, lo, hi);
+        for (int a = 0; a < 3; ++a) inv[a] = 1.0f / ((float)d->grid->dims[a] * d->grid->voxel);
+        set3(u->box_min, lo, 0.0f);
+        set3(u->box_max, hi, 0.0f);
+        set3(u->tex_min, d->grid->origin, 0.0f);
+        set3(u->tex_inv_size, inv, 0.0f);
+        float md = VEIL_MIN_LIGHT_DISTANCE_VOXELS * d->grid->voxel;
+        u->march[0] = d->step_voxels * d->grid->voxel;
+        u->march[1] = md * md;
+        u->march[2] = d->grid->voxel;
+    } else {
+        float md = VEIL_MIN_LIGHT_DISTANCE_VOXELS * VEIL_FOG_MIN_STEP;
+        u->march[0] = VEIL_FOG_MIN_STEP;
+        u->march[1] = md * md;
+    }
+    u->march[3] = g;
+    u->limits[0] = d->max_distance > 0.0f ? d->max_distance : 3.0e38f;
+    int fogs = 0;
+    for (size_t i = 0; i < m->source_count && fogs < VEIL_MAX_FOGS; ++i) {
+        const veil_source* src = &m->sources[i];
+        if (src->type != VEIL_SOURCE_EXPONENTIAL) continue;
+        veil_gpu_fog* f = &u->fogs[fogs++];
+        set3(f->direction, src->fog.direction, src->fog.density);
+        set3(f->origin, src->fog.origin, src->fog.falloff);
+        set3(f->box_min, src->fog.bounds[0], 0.0f);
+        set3(f->box_max, src->fog.bounds[1], 0.0f);
+    }
+    int n = d->light_count < VEIL_MAX_LIGHTS ? d->light_count : VEIL_MAX_LIGHTS;
+    for (int l = 0; l < n; ++l) veil_gpu_light_from(&d->lights[l], &u->lights[l]);
+    u->size[0] = d->width, u->size[1] = d->height, u->size[2] = n, u->size[3] = fogs;
+    u->flags[0] = d->grid != NULL;
+    u->flags[1] = d->grid != NULL && fogs == 0 && d->skip_empty;
+    u->flags[2] = d->seed;
+    return VEIL_OK;
+}
+
+static veil_result image(int w, int h, const char* label, GLuint* tex, veil_error* err)
+{
+    glCreateTextures(GL_TEXTURE_2D, 1, tex);
+    glTextureStorage2D(*tex, 1, GL_RGBA32F, w, h);
+    glObjectLabel(GL_TEXTURE, *tex, -1, label);
+    return veil_gl_check(label, err);
+}
+
+veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_set* out, veil_error* err)
+{
+    veil_image_set_free(out);
+    veil_march_block u;
+    veil_result r = veil_march_block_fill(d, &u, err);
+    if (r != VEIL_OK) return r;
+    int w = d->width, h = d->height;
+    size_t floats;
+    if (!veil_mul_sizes((size_t)w, (size_t)h, 4, 1, &floats)) return veil_fail(err, VEIL_ERR_LIMIT, "image too large");
+    GLuint tex[3] = {0};
+    static const char* const labels[3] = {"veil image", "veil image T, P", "veil image single, depth"};
+    static const GLuint units[3] = {VEIL_IMAGE_OUT, VEIL_IMAGE_AOV_T, VEIL_IMAGE_AOV_S};
+    for (int i = 0; i < 3 && r == VEIL_OK; ++i) r = image(w, h, labels[i], &tex[i], err);
+    float** dst[3] = {&out->rgba, &out->aov_t, &out->aov_s};
+    for (int i = 0; i < 3 && r == VEIL_OK; ++i) {
+        *dst[i] = malloc(floats * sizeof(float));
+        if (!*dst[i]) r = veil_fail(err, VEIL_ERR_OOM, "out of memory for a %dx%d image", w, h);
+    }
+    if (r == VEIL_OK) {
+        out->width = w, out->height = h;
+        glNamedBufferSubData(m->ubo, 0, sizeof u, &u);
+        glUseProgram(m->program);
+        glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, m->ubo);
+        glBindTextureUnit(VEIL_TEX_EV, d->grid ? d->ev : 0);
+        glBindTextureUnit(VEIL_TEX_OCC, d->grid ? d->occupancy : 0);
+        for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, d->opv ? d->opv[t] : 0);
+        for (int i = 0; i < 3; ++i) glBindImageTexture(units[i], tex[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        glDispatchCompute(veil_groups(w, VEIL_MARCH_GROUP), veil_groups(h, VEIL_MARCH_GROUP), 1);
+        glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+        for (int i = 0; i < 3; ++i) glBindImageTexture(units[i], 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        for (int t = 0; t <= VEIL_TEX_OCC; ++t) glBindTextureUnit((GLuint)t, 0);
+        glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, 0);
+        glUseProgram(0);
+        r = veil_gl_check("ray march (render/shaders/march.comp)", err);
+        for (int i = 0; i < 3 && r == VEIL_OK; ++i)
+            r = veil_gl_read_texture(tex[i], GL_RGBA, floats, *dst[i], "reading back the image", err);
+    }
+    glDeleteTextures(3, tex);
+    if (r != VEIL_OK) veil_image_set_free(out);
+    return r;
+}

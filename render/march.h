@@ -1,0 +1,61 @@
+/* veil — the single-scattering ray march (render/shaders/march.comp): one
+ * invocation per pixel, from the camera through the EV (trilinear over its
+ * voxel centres' box) and the analytic fogs, lit through the optical-depth
+ * volumes. Writes an image set (render/image_set.h).
+ *
+ * The march owns its program; the volume, the OPVs and the lights are the
+ * caller's (frame/ brings them up to date first). Needs the GL context
+ * current at creation.
+ */
+#ifndef VEIL_MARCH_H
+#define VEIL_MARCH_H
+
+#include <epoxy/gl.h>
+#include <stdint.h>
+
+#include "../core/result.h"
+#include "../scene/scene.h"
+#include "../volume/volume.h"
+#include "image_set.h"
+
+/* Ray-march step as a fraction of the voxel edge. Half a voxel resolves the
+ * trilinear medium between centres; the step error is measured, not assumed. */
+#define VEIL_DEFAULT_STEP_VOXELS 0.5f
+
+/* The smallest march step through fog when there is no volume (m). */
+#define VEIL_FOG_MIN_STEP 0.01f
+
+/* Point lights closer than this fraction of a voxel count as this far (the
+ * 1/r^2 singularity is integrable in the continuum but not in samples). */
+#define VEIL_MIN_LIGHT_DISTANCE_VOXELS 1e-3f
+
+typedef struct veil_march veil_march;
+
+typedef struct veil_march_desc {
+    const veil_scene* scene;   /* medium coefficients, fogs, background */
+    const veil_camera* camera;
+    int width, height;
+    const veil_light* lights;  /* the lights that add light (frame/ drops the rest) */
+    int light_count;
+    const veil_grid* grid;     /* NULL: no volume (fog only) */
+    GLuint ev, occupancy;      /* the EV's textures when grid is set */
+    const GLuint* opv;         /* VEIL_MAX_OPV_TEXTURES textures (0 where unused) */
+    float step_voxels;         /* > 0 */
+    uint32_t seed;             /* jitter seed */
+    int skip_empty;            /* 1: jump over bricks without density (when there is no fog) */
+    float max_distance;        /* > 0: no step starts at or beyond it (m); 0: no limit */
+} veil_march_desc;
+
+veil_result veil_march_create(veil_march** out, veil_error* err);
+void veil_march_destroy(veil_march* m); /* accepts NULL */
+
+/* The uniform block for d (exposed so tests can check what the shader gets). */
+veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* out, veil_error* err);
+
+/* Marches every pixel and reads the image set back (*out: freed first). */
+veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_set* out, veil_error* err);
+
+/* One light in the GPU's shape. */
+void veil_gpu_light_from(const veil_light* l, veil_gpu_light* out);
+
+#endif

@@ -1,0 +1,63 @@
+/* veil — the extinction volume (EV) on the GPU, behind one handle.
+ *
+ * Today the EV is dense: an r32f 3D texture of the grid's size (density,
+ * unitless; sigma_t = (sigma_a + sigma_s) * density, m^-1) and its
+ * occupancy bricks (volume/shaders/occupancy.comp: the largest density in
+ * each VEIL_BRICK^3 brick and the voxel ring around it, so the marcher may
+ * skip bricks without density). A sparse layout can come in behind the same
+ * calls. The handle owns its textures and programs and needs the GL context
+ * that was current when it was created; it does not know about caching:
+ * frame/ decides when to rebuild it (the key is the caller's).
+ */
+#ifndef VEIL_EV_H
+#define VEIL_EV_H
+
+#include <epoxy/gl.h>
+#include <stdint.h>
+
+#include "../core/result.h"
+#include "scene_volume.h"
+#include "volume.h"
+
+typedef struct veil_ev veil_ev;
+
+/* What a build did, for the stage report. */
+typedef struct veil_ev_report {
+    size_t particles;  /* RBF particles splatted */
+    size_t vdb_voxels; /* active voxels of the OpenVDB grids resampled */
+} veil_ev_report;
+
+veil_result veil_ev_create(veil_ev** out, veil_error* err); /* compiles the inject and occupancy programs */
+void veil_ev_destroy(veil_ev* ev);                          /* accepts NULL */
+
+/* Drops the volume (an empty medium: no texture at all). */
+void veil_ev_clear(veil_ev* ev);
+
+/* 1 when the EV holds a volume; its grid and textures (0 when none). */
+int veil_ev_present(const veil_ev* ev);
+const veil_grid* veil_ev_grid(const veil_ev* ev);
+GLuint veil_ev_texture(const veil_ev* ev);
+GLuint veil_ev_occupancy(const veil_ev* ev);
+
+/* The GPU bytes of an EV of grid g plus the optical-depth textures of
+ * n_lights lights (and their scratch texture), refused with the numbers
+ * when over `budget` bytes or the address space: checked before anything
+ * is made. */
+veil_result veil_ev_check_budget(const veil_grid* g, int n_lights, unsigned long long budget, veil_error* err);
+
+/* Builds the EV of a scene's voxelised sources (v->has_volume): the OpenVDB
+ * grids resampled on the CPU and uploaded, the RBF particles splatted on
+ * the GPU, then the occupancy bricks. On failure the EV is empty. */
+veil_result veil_ev_build_scene(veil_ev* ev, const veil_scene_volume* v, int n_lights,
+                                unsigned long long budget, veil_ev_report* rep, veil_error* err);
+
+/* Builds the EV from a density given on grid g (veil_grid_voxels floats). */
+veil_result veil_ev_build_density(veil_ev* ev, const veil_grid* g, const float* density, int n_lights,
+                                  unsigned long long budget, veil_error* err);
+
+/* The RBF splat alone, read back into density (veil_grid_voxels floats):
+ * tests compare it with the C splat. Leaves the EV as it was. */
+veil_result veil_ev_splat_readback(veil_ev* ev, const veil_grid* g, const veil_particle* p, size_t n,
+                                   float* density, veil_error* err);
+
+#endif
