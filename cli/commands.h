@@ -5,6 +5,10 @@
 #define VEIL_CLI_COMMANDS_H
 
 int veil_cmd_compare(int argc, char** argv);
+int veil_cmd_gpuinfo(int argc, char** argv);
+int veil_cmd_info(int argc, char** argv);
+int veil_cmd_rbf(int argc, char** argv);
+int veil_cmd_render(int argc, char** argv);
 int veil_cmd_reference(int argc, char** argv);
 
 #endif

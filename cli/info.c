@@ -1,0 +1,73 @@
+/* veil info: the grids of an OpenVDB file, as a table or JSON. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli_util.h"
+#include "commands.h"
+#include "io/vdb.h"
+
+static void print_info_grid(const veil_vdb_grid_info* g)
+{
+    printf("\ngrid '%s'\n", g->name);
+    if (g->active_voxels == 0) {
+        printf("  index bbox   (empty)\n");
+    } else {
+        printf("  index bbox   [%d, %d, %d] .. [%d, %d, %d]  (%d x %d x %d)\n", g->index_lo[0], g->index_lo[1],
+               g->index_lo[2], g->index_hi[0], g->index_hi[1], g->index_hi[2], g->index_hi[0] - g->index_lo[0] + 1,
+               g->index_hi[1] - g->index_lo[1] + 1, g->index_hi[2] - g->index_lo[2] + 1);
+        if (g->affine)
+            printf("  world bbox   [%g, %g, %g] .. [%g, %g, %g] m\n", g->world_lo[0], g->world_lo[1], g->world_lo[2],
+                   g->world_hi[0], g->world_hi[1], g->world_hi[2]);
+    }
+    printf("  transform    %s%s\n", g->map_type, g->affine ? " (index to world, column vectors)" : " (not affine)");
+    for (int r = 0; g->affine && r < 4; ++r)
+        printf("               [%10.6g %10.6g %10.6g %10.6g]\n", g->index_to_world[r][0], g->index_to_world[r][1],
+               g->index_to_world[r][2], g->index_to_world[r][3]);
+}
+
+int veil_cmd_info(int argc, char** argv)
+{
+    const char* path = NULL;
+    int json = 0;
+    for (int i = 2; i < argc; ++i) {
+        if (!strcmp(argv[i], "--json")) json = 1;
+        else if (argv[i][0] == '-' && argv[i][1]) return veil_cli_usage_error("unknown option '%s'", argv[i]);
+        else if (!path) path = argv[i];
+        else return veil_cli_usage_error("unexpected argument '%s'", argv[i]);
+    }
+    if (!path) return veil_cli_usage_error("%s", "info: missing FILE.vdb");
+    veil_error err = {0};
+    if (json) {
+        char* text = NULL;
+        veil_result r = veil_vdb_info_json(path, &text, &err);
+        if (r != VEIL_OK) return veil_cli_fail(r, &err);
+        puts(text);
+        free(text);
+        return EXIT_OK;
+    }
+    veil_vdb_grid_info* grids = NULL;
+    size_t n = 0;
+    veil_result r = veil_vdb_file_info(path, &grids, &n, &err);
+    if (r != VEIL_OK) return veil_cli_fail(r, &err);
+    int w = 4; /* name column: the longest name */
+    for (size_t i = 0; i < n; ++i) w = (int)strlen(grids[i].name) > w ? (int)strlen(grids[i].name) : w;
+    printf("%s: %zu grid%s\n\n", path, n, n == 1 ? "" : "s");
+    printf("  %-*s  %-10s  %-8s  %13s  %s\n", w, "name", "class", "type", "active voxels", "voxel size (m)");
+    for (size_t i = 0; i < n; ++i) {
+        const veil_vdb_grid_info* g = &grids[i];
+        char vs[96];
+        if (fabs(g->voxel_size[0] - g->voxel_size[1]) <= 1e-9 * g->voxel_size[0] &&
+            fabs(g->voxel_size[1] - g->voxel_size[2]) <= 1e-9 * g->voxel_size[0]) /* uniform, up to rounding */
+            snprintf(vs, sizeof vs, "%g", g->voxel_size[0]);
+        else
+            snprintf(vs, sizeof vs, "%g x %g x %g", g->voxel_size[0], g->voxel_size[1], g->voxel_size[2]);
+        printf("  %-*s  %-10s  %-8s  %13llu  %s\n", w, g->name, g->grid_class, g->value_type,
+               (unsigned long long)g->active_voxels, vs);
+    }
+    for (size_t i = 0; i < n; ++i) print_info_grid(&grids[i]);
+    veil_vdb_file_info_free(grids, n);
+    return EXIT_OK;
+}
+
