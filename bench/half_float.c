@@ -35,6 +35,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/rng.h"
 #include "media.h"
 #include "propagate/opv.h"
 #include "reference/optical_depth.h"
@@ -173,13 +174,7 @@ static int selftest(void)
 /* ---- section 1: the extinction volume ------------------------------------- */
 
 static uint64_t rng_state = 0x5eed0f0bULL;
-static double uniform01(void)
-{
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return (double)((z ^ (z >> 31)) >> 11) * 0x1p-53;
-}
+static double uniform01(void) { return veil_rng_double53(&rng_state); }
 
 typedef struct depth_err {
     double max_rel, max_dT;

@@ -39,6 +39,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/rng.h"
 #include "propagate/opv.h"
 #include "propagate/opv_gpu.h"
 #include "reference/optical_depth.h"
@@ -77,15 +78,7 @@ static const veil_light bench_lights[LIGHT_COUNT] = {
 
 /* ---- deterministic random numbers ---------------------------------------- */
 
-static uint64_t splitmix64(uint64_t* s)
-{
-    uint64_t z = (*s += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-
-static double uniform01(uint64_t* s) { return (double)(splitmix64(s) >> 11) * 0x1p-53; }
+static double uniform01(uint64_t* s) { return veil_rng_double53(s); }
 
 typedef struct medium_stats {
     double max, mean, empty_fraction;
@@ -132,7 +125,7 @@ static size_t* make_samples(const veil_grid* g, size_t* count)
         uint64_t rng = SAMPLE_SEED ^ (uint64_t)g->dims[0];
         size_t have = 0;
         while (have < n) {
-            while (have < n) s[have++] = (size_t)(splitmix64(&rng) % nv);
+            while (have < n) s[have++] = (size_t)(veil_splitmix64(&rng) % nv);
             qsort(s, have, sizeof(size_t), cmp_size);
             size_t u = 0;
             for (size_t i = 0; i < have; ++i)

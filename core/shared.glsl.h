@@ -29,6 +29,7 @@
 #define VEIL_STRUCT_END(name) };
 #else
 #include <math.h>
+#include <stdbool.h> /* GLSL's bool, used by the shared schemes (propagate/opv_schemes.glsl.h) */
 #define VEIL_FN static inline
 #define VEIL_PRECISE /* C is compiled with -ffp-contract=off */
 #define VEIL_EXPF expf

@@ -2,7 +2,7 @@
  *
  * It renders what the GPU pipeline approximates, without its
  * approximations: the same camera (one ray through each pixel's centre, as
- * render/camera.h; no anti-aliasing, as the marcher), the same lights
+ * scene/camera.h; no anti-aliasing, as the marcher), the same lights
  * (point and spot: intensity / r^2 with no distance floor; spot cone
  * falloff veil_spot_falloff; directional: irradiance), the same phase
  * function (isotropic or Henyey-Greenstein), and the same medium: the
@@ -122,8 +122,5 @@ veil_result veil_pt_render(const veil_pt_medium* m, const veil_scene* s, const v
  * `dir` the path travels in, a unit direction whose cosine with dir has the
  * HG density veil_phase_hg (isotropic for g = 0), azimuth uniform. */
 void veil_pt_sample_hg(const double dir[3], double g, double u1, double u2, double out[3]);
-
-/* The medium's density (volume + fogs, unitless) at x. */
-double veil_pt_density(const veil_pt_medium* m, const double x[3]);
 
 #endif

@@ -187,18 +187,6 @@ static double fog_log_density(const pt_fog* f, const double x[3])
     return log(f->rho0) - f->falloff * k;
 }
 
-double veil_pt_density(const veil_pt_medium* m, const double x[3])
-{
-    double rho = m->has_grid ? veil_ev_sample(&m->grid, m->rho, x) : 0.0;
-    for (int i = 0; i < m->fog_count; ++i) {
-        const pt_fog* f = &m->fog[i];
-        int inside = 1;
-        for (int a = 0; a < 3; ++a) inside &= x[a] >= f->lo[a] && x[a] <= f->hi[a];
-        if (inside) rho += exp(fog_log_density(f, x));
-    }
-    return rho;
-}
-
 /* ---- the volume's majorant walk ----------------------------------------------- */
 
 typedef struct dda {

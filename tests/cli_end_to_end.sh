@@ -1,10 +1,15 @@
 #!/usr/bin/env bash
 # End to end through the CLI: gpuinfo, usage errors, and the demo scene at a
-# small size — the EXR and PNG exist, are complete, and hold finite values.
+# small size — the EXR and PNG exist, are complete, and hold finite values:
+# every channel of the EXR is finite, R, G, B >= 0 and A in [0, 1], and the
+# PNG decodes at the size asked for (tests/exr_stats.c, which first shows it
+# rejects an EXR with a NaN, an infinity, a negative colour or an alpha > 1).
 # Exit 77 (skipped) when no GL context can be made, except under CI=true.
+#   cli_end_to_end.sh VEIL SCENE EXR_STATS
 set -u
 veil=$1
 scene=$2
+stats=$3
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
@@ -16,6 +21,21 @@ fail() { echo "FAIL: $*"; exit 1; }
 "$veil" render "$scene" -o "$tmp/no/such/dir/x.exr" 2> "$tmp/nodir.err"; [ $? -eq 1 ] || fail "missing output folder must exit 1"
 grep -q "the folder '$tmp/no/such/dir' does not exist" "$tmp/nodir.err" || fail "missing folder message: $(cat "$tmp/nodir.err")"
 "$veil" frobnicate 2>/dev/null; [ $? -eq 2 ] || fail "unknown command must exit 2"
+
+# The value checker checks: it passes a good EXR and fails (exit 1) on each
+# kind of bad value. No GPU needed.
+"$stats" --write-bad none "$tmp/good.exr" || fail "exr_stats cannot write good.exr"
+"$stats" --rgba "$tmp/good.exr" > "$tmp/good.txt" || fail "exr_stats rejects a good EXR: $(cat "$tmp/good.txt")"
+for kind in nan inf negative alpha; do
+  "$stats" --write-bad $kind "$tmp/$kind.exr" || fail "exr_stats cannot write $kind.exr"
+  "$stats" --rgba "$tmp/$kind.exr" > "$tmp/$kind.txt" 2>&1; rc=$?
+  [ $rc -eq 1 ] || fail "exr_stats --rgba on an EXR with a bad value ($kind) exited $rc, expected 1: $(cat "$tmp/$kind.txt")"
+done
+"$stats" "$tmp/nan.exr" > "$tmp/nan.txt" 2>&1; rc=$?
+[ $rc -eq 1 ] || fail "exr_stats on an EXR with a NaN exited $rc, expected 1"
+grep -q '^G .*non-finite 1' "$tmp/nan.txt" || fail "exr_stats does not count the NaN in G: $(cat "$tmp/nan.txt")"
+"$stats" --png "$tmp/good.exr" 4 3 > /dev/null 2>&1 && fail "exr_stats --png decodes an EXR as a PNG"
+rm -f "$tmp"/*.exr "$tmp"/*.txt
 
 if ! "$veil" gpuinfo > "$tmp/gpuinfo.txt" 2> "$tmp/gpuinfo.err"; then
   cat "$tmp/gpuinfo.err"
@@ -48,5 +68,9 @@ done
 [ -s "$tmp/demo.exr" ] || fail "no EXR"
 head -c 4 "$tmp/demo.exr" | od -An -tx1 | grep -q '76 2f 31 01' || fail "EXR magic"
 head -c 8 "$tmp/demo.png" | od -An -tx1 | grep -q '89 50 4e 47 0d 0a 1a 0a' || fail "PNG signature"
+"$stats" --rgba "$tmp/demo.exr" > "$tmp/stats.txt" 2>&1 || fail "EXR values: $(cat "$tmp/stats.txt")"
+cat "$tmp/stats.txt"
+grep -q "demo.exr: 96x72, " "$tmp/stats.txt" || fail "EXR size: $(cat "$tmp/stats.txt")"
+"$stats" --png "$tmp/demo.png" 96 72 > "$tmp/png.txt" 2>&1 || fail "PNG: $(cat "$tmp/png.txt")"
 ls "$tmp" | grep -q tmp && fail "temporary file left behind: $(ls "$tmp")"
 echo "PASS"

@@ -25,6 +25,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "core/rng.h"
 #include "io/scene.h"
 #include "reference/optical_depth.h"
 #include "reference/pathtracer.h"
@@ -305,12 +306,7 @@ static void test_hg_sampling(double g)
     int bad_norm = 0;
     for (int i = 0; i < N; ++i) {
         double u[2];
-        for (int k = 0; k < 2; ++k) { /* SplitMix64 */
-            uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-            z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-            z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-            u[k] = (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
-        }
+        for (int k = 0; k < 2; ++k) u[k] = veil_rng_double53(&state);
         double w[3];
         veil_pt_sample_hg(dir, g, u[0], u[1], w);
         double n2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];

@@ -1,21 +1,16 @@
-/* veil tests — a seeded SplitMix64 stream and small vector helpers shared by
- * the reference tests (each test file gets its own stream). */
+/* veil tests — a seeded SplitMix64 stream (core/rng.h) and small vector
+ * helpers shared by the reference tests (each test file gets its own stream). */
 #ifndef VEIL_TEST_RANDOM_H
 #define VEIL_TEST_RANDOM_H
 
 #include <math.h>
 #include <stdint.h>
 
+#include "core/rng.h"
+
 static uint64_t rng = 0x5eed0fu;
 
-static inline double rnd(void) /* [0, 1), 53 bits */
-{
-    uint64_t z = (rng += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return (double)(z >> 11) * (1.0 / 9007199254740992.0);
-}
+static inline double rnd(void) { return veil_rng_double53(&rng); } /* [0, 1), 53 bits */
 
 static inline double rnd_in(double lo, double hi) { return lo + (hi - lo) * rnd(); }
 

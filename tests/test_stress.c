@@ -15,7 +15,7 @@
  *  - transmittance does not increase along rays: the scene is rendered
  *    again with max_distance at three increasing distances spanning the
  *    medium. Those renders march exactly the steps of the full render up to
- *    the limit (render/renderer.h), T only ever multiplies by
+ *    the limit (frame/renderer.h), T only ever multiplies by
  *    exp(-x) <= 1 with x >= 0, and rounding is monotone (a smaller factor
  *    or a smaller channel never rounds to a larger product or sum), so per
  *    pixel alpha must be non-decreasing with max_distance EXACTLY: no
@@ -653,7 +653,7 @@ int main(int argc, char** argv)
     const double t0 = veil_now_ms();
     for (int i = first; i < first + scenes; ++i) {
         gen_scene gs;
-        rng = seed ^ (0x9E3779B97F4A7C15ull * (uint64_t)(i + 1)), rnd(); /* scene i's own stream */
+        rng = seed ^ (VEIL_RNG_GAMMA * (uint64_t)(i + 1)), rnd(); /* scene i's own stream */
         gen_scene_json(&json, &gs);
         ++t.scenes;
         const uint64_t cut = t.pt_cut_walks + t.pt_dropped;

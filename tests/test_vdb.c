@@ -5,17 +5,24 @@
  *
  * One ctest per CASE (tests/vdb_tests.cmake): open, select, level_set,
  * types, bad_files, empty, transform, threads, fast_path, mass, rotated,
- * limits.
+ * limits, scene_volume.
  */
 #define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "check.h"
+#include "io/scene.h"
 #include "io/vdb.h"
+#include "volume/scene_volume.h"
 #include "volume/vdb_volume.h"
 
 /* The issue's requirement for Σ density x voxel volume after resampling;
@@ -554,6 +561,108 @@ static void test_limits(void)
     veil_vdb_close(v);
 }
 
+/* ---- a scene's VDB source: open with err == NULL, and the volume key ---- */
+
+/* Writes n bytes to path in place (same inode), then sets its access and
+ * modification times to sec seconds (utimensat), so that a test controls
+ * the file's size and mtime exactly. */
+static void write_file(const char* path, const char* bytes, size_t n, time_t sec)
+{
+    FILE* f = fopen(path, "wb");
+    CHECK(f && fwrite(bytes, 1, n, f) == n, "write %s: %s", path, strerror(errno));
+    if (f) CHECK(fclose(f) == 0, "close %s", path);
+    const struct timespec t[2] = {{.tv_sec = sec}, {.tv_sec = sec}};
+    CHECK(utimensat(AT_FDCWD, path, t, 0) == 0, "utimensat %s: %s", path, strerror(errno));
+}
+
+/* veil_scene_volume_open(..., err = NULL) fails cleanly (core/result.h lets
+ * callers pass NULL; a failed veil_vdb_open once made it read *err), and
+ * veil_scene_volume_key() of a VDB source is the file's identity: path,
+ * size, mtime (and inode, device), never its bytes, so the key is formed
+ * without opening the file. The chosen semantics, checked here: a missing
+ * file keys differently from a present one; a new size or mtime changes
+ * the key; the same file keys the same twice; new bytes with size and
+ * mtime restored keep the key (the renderer's cache then reuses the old
+ * volume: writers of VDB files change the mtime, as any rewrite does). */
+static void test_scene_volume(void)
+{
+    char dir[4096], path[4200], json[8700];
+    snprintf(dir, sizeof dir, "%s/scene_volume_XXXXXX", g_dir);
+    if (!mkdtemp(dir)) {
+        CHECK(0, "mkdtemp %s: %s", dir, strerror(errno));
+        return;
+    }
+    snprintf(path, sizeof path, "%s/cloud.vdb", dir);
+    snprintf(json, sizeof json,
+             "{\"camera\": {\"position\": [0, 0, 4], \"look_at\": [0, 0, 0]},"
+             " \"medium\": {\"sigma_s\": [1, 1, 1], \"sources\": [{\"type\": \"vdb\", \"file\": \"%s\"}]}}",
+             path);
+    /* the parser checks that the file exists; it goes away after */
+    write_file(path, "not an OpenVDB file\n", 20, 1000000000);
+    veil_scene s;
+    veil_error err = {0};
+    veil_result r = veil_scene_parse("scene_volume.json", json, strlen(json), &s, &err);
+    CHECK(r == VEIL_OK, "scene: %s", err.msg);
+    CHECK(unlink(path) == 0, "unlink %s: %s", path, strerror(errno));
+    if (r != VEIL_OK) {
+        rmdir(dir);
+        return;
+    }
+    veil_scene_volume v;
+
+    /* missing file (removed since the scene was read) */
+    memset(&v, 0xA5, sizeof v);
+    r = veil_scene_volume_open(&s, &v, NULL);
+    CHECK(r == VEIL_ERR_IO, "missing file, err NULL: %s, expected VEIL_ERR_IO", veil_result_name(r));
+    CHECK(v.vdb_count == 0 && !v.particles && !v.has_volume, "a failed open leaves *out closed");
+    veil_scene_volume_close(&v);
+    r = veil_scene_volume_open(&s, &v, &err); /* the same path with a buffer: it says why */
+    CHECK(r == VEIL_ERR_IO && strstr(err.msg, "medium.sources[0]") && strstr(err.msg, "cloud.vdb"), "%s: %s",
+          veil_result_name(r), err.msg);
+    const uint64_t k_missing = veil_scene_volume_key(&s);
+    CHECK(veil_scene_volume_key(&s) == k_missing, "the key of a missing file is not stable");
+
+    /* a corrupt file (20 bytes, mtime 10^9 s) */
+    write_file(path, "not an OpenVDB file\n", 20, 1000000000);
+    memset(&v, 0xA5, sizeof v);
+    r = veil_scene_volume_open(&s, &v, NULL);
+    CHECK(r == VEIL_ERR_IO, "corrupt file, err NULL: %s, expected VEIL_ERR_IO", veil_result_name(r));
+    CHECK(v.vdb_count == 0 && !v.particles && !v.has_volume, "a failed open leaves *out closed");
+    r = veil_scene_volume_open(&s, &v, &err);
+    CHECK(r == VEIL_ERR_IO && strstr(err.msg, "medium.sources[0]") && strstr(err.msg, "OpenVDB said"), "%s: %s",
+          veil_result_name(r), err.msg);
+    const uint64_t k1 = veil_scene_volume_key(&s);
+    CHECK(k1 != k_missing, "the file appeared and the key stayed %016llx", (unsigned long long)k1);
+    CHECK(veil_scene_volume_key(&s) == k1, "an unchanged file's key is not stable");
+
+    /* another size, same mtime */
+    write_file(path, "not an OpenVDB file either\n", 27, 1000000000);
+    const uint64_t k2 = veil_scene_volume_key(&s);
+    CHECK(k2 != k1, "a new size kept the key");
+    /* same size, another mtime */
+    write_file(path, "not an OpenVDB file either\n", 27, 1000000001);
+    const uint64_t k3 = veil_scene_volume_key(&s);
+    CHECK(k3 != k2 && k3 != k1, "a new mtime kept the key");
+    /* other bytes, size and mtime restored: the same identity, the same key */
+    write_file(path, "NOT AN OPENVDB FILE EITHER\n", 27, 1000000001);
+    CHECK(veil_scene_volume_key(&s) == k3, "the key changed with the bytes alone: it must not read the file");
+    /* unreadable (stat still works): the key is formed without opening. As
+     * root the file stays readable, so this would prove nothing. */
+    if (geteuid() != 0) {
+        CHECK(chmod(path, 0) == 0, "chmod %s: %s", path, strerror(errno));
+        CHECK(veil_scene_volume_key(&s) == k3, "the key of an unreadable file differs: it reads the file");
+        r = veil_scene_volume_open(&s, &v, NULL);
+        CHECK(r == VEIL_ERR_IO, "unreadable file, err NULL: %s", veil_result_name(r));
+        chmod(path, 0600);
+    } else {
+        printf("running as root: the unreadable-file check is skipped\n");
+    }
+    printf("keys: missing %016llx, 20 B %016llx, 27 B %016llx, new mtime %016llx\n", (unsigned long long)k_missing,
+           (unsigned long long)k1, (unsigned long long)k2, (unsigned long long)k3);
+    veil_scene_free(&s);
+    CHECK(unlink(path) == 0 && rmdir(dir) == 0, "cleaning %s: %s", dir, strerror(errno));
+}
+
 int main(int argc, char** argv)
 {
     if (argc != 3) {
@@ -567,7 +676,8 @@ int main(int argc, char** argv)
     } cases[] = {{"open", test_open},       {"select", test_select},       {"level_set", test_level_set},
                  {"types", test_types},     {"bad_files", test_bad_files}, {"empty", test_empty},
                  {"transform", test_transform}, {"threads", test_threads}, {"fast_path", test_fast_path},
-                 {"mass", test_mass},       {"rotated", test_rotated},     {"limits", test_limits}};
+                 {"mass", test_mass},       {"rotated", test_rotated},     {"limits", test_limits},
+                 {"scene_volume", test_scene_volume}};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i)
         if (strcmp(argv[2], cases[i].name) == 0) {
             cases[i].fn();
