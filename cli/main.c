@@ -1,7 +1,8 @@
 /* veil — the command-line tool.
  *
  *   veil render SCENE.json -o OUT.exr [--png OUT.png] [--width W] [--height H]
- *               [--step S] [--seed N] [--method M] [--turntable N] [--stats]
+ *               [--step S] [--seed N] [--method M] [--turntable N] [--aovs] [--stats]
+ *               [--explain]
  *   veil gpuinfo
  *   veil info FILE.vdb [--json]
  *   veil rbf generate -o OUT --count N --seed S --bounds x0,y0,z0,x1,y1,z1
@@ -20,7 +21,8 @@
 
 static const char* usage_text =
     "usage: veil render SCENE.json -o OUT.exr [--png OUT.png] [--width W] [--height H]\n"
-    "                   [--step S] [--seed N] [--method M] [--turntable N] [--stats]\n"
+    "                   [--step S] [--seed N] [--method M] [--turntable N] [--aovs]\n"
+    "                   [--stats] [--explain]\n"
     "       veil reference SCENE.json -o REF.exr --spp N [--max-order K] [--width W]\n"
     "                [--height H] [--seed N] [--threads T]\n"
     "       veil compare A.exr REF.exr [--heatmap OUT.png] [--floor F] [--json]\n"
@@ -43,7 +45,14 @@ static const char* usage_text =
     "  --turntable N  N frames with the camera orbiting the look-at point about the\n"
     "                 up axis, written as OUT_0000.exr ... (volume and optical depth\n"
     "                 are computed once and reused: see --stats)\n"
-    "  --stats        print the wall time of each stage in milliseconds\n"
+    "  --aovs         also write the AOV channels T.R, T.G, T.B (transmittance), P (density\n"
+    "                 integral along the ray), single.R, single.G, single.B (single scattering\n"
+    "                 without the background) and depth (mean distance of the first\n"
+    "                 interaction, m; 0 where the ray meets no medium)\n"
+    "  --stats        print each stage's wall time in milliseconds, whether it ran, was\n"
+    "                 cached or skipped, and why\n"
+    "  --explain      print which stages run on which frame and why, without rendering\n"
+    "                 (no GPU needed; -o may be left out)\n"
     "reference  renders a scene with the CPU path tracer (reference/pathtracer.h), the\n"
     "         ground truth the GPU path is measured against. The EXR holds R, G, B, A and\n"
     "         the per-pixel standard error of each mean (stderr.R, stderr.G, stderr.B).\n"

@@ -1,43 +1,17 @@
-/* veil — result codes and error messages.
+/* veil — result codes and error messages, as the library uses them.
  *
- * Every fallible library function returns a veil_result and, where the caller
+ * The codes, the veil_error buffer, veil_result_name() and
+ * veil_result_message() are public: include/veil/result.h, the one place the
+ * codes are defined. This header adds the library's own helpers. Every
+ * fallible library function returns a veil_result and, where the caller
  * passes one, fills a veil_error with a sentence that names the file, the
  * field and what was expected (or the EGL/GL call and its code). The library
  * never prints and never exits; only the CLI maps results to exit codes.
- *
- * The table below is the one place the codes are defined: it yields the enum,
- * the name and a generic message.
  */
 #ifndef VEIL_RESULT_H
 #define VEIL_RESULT_H
 
-#include <stddef.h>
-#include <stdint.h>
-
-/* X(name, value, generic message) */
-#define VEIL_RESULTS(X)                                                        \
-    X(VEIL_OK, 0, "success")                                                   \
-    X(VEIL_ERR_IO, 1, "a file could not be read or written")                   \
-    X(VEIL_ERR_PARSE, 2, "malformed input")                                    \
-    X(VEIL_ERR_INVALID, 3, "invalid argument or field value")                  \
-    X(VEIL_ERR_OOM, 4, "out of memory")                                        \
-    X(VEIL_ERR_LIMIT, 5, "a size exceeds a limit")                             \
-    X(VEIL_ERR_GPU, 6, "GPU or driver failure")                                \
-    X(VEIL_ERR_SHADER, 7, "shader compile or link failed")
-
-typedef int32_t veil_result;
-enum {
-#define VEIL__ENUM(name, value, msg) name = value,
-    VEIL_RESULTS(VEIL__ENUM)
-#undef VEIL__ENUM
-};
-
-#define VEIL_ERROR_MAX 2048
-
-/* A message buffer; zero-initialise it. */
-typedef struct veil_error {
-    char msg[VEIL_ERROR_MAX];
-} veil_error;
+#include "../include/veil/result.h"
 
 /* Formats into err->msg (err may be NULL) and returns `code`, so that
  * `return veil_fail(err, VEIL_ERR_IO, "%s: ...", path);` reads naturally. */
@@ -46,9 +20,6 @@ veil_result veil_fail(veil_error* err, veil_result code, const char* fmt, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
-
-const char* veil_result_name(veil_result r);    /* "VEIL_ERR_IO" */
-const char* veil_result_message(veil_result r); /* generic text */
 
 /* True when n = a*b*c*d fits in size_t; writes the product to *out. */
 int veil_mul_sizes(size_t a, size_t b, size_t c, size_t d, size_t* out);

@@ -241,7 +241,7 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
                           .step_voxels = o->step_voxels, .seed = o->seed, .skip_empty = !o->no_skip,
                           .max_distance = o->max_distance};
     res = veil_march_run(r->march, &md, images, err);
-    veil_stage_report* rep = &st->stage[VEIL_STAGE_MARCH];
+    veil_stage_report* rep = &st->stage[VEIL_STAGE_RENDER];
     rep->ms = veil_now_ms() - t1;
     rep->status = VEIL_STAGE_RAN;
     why(rep, "%dx%d, %d lights, step %g voxels: depends on the camera, runs every frame", o->width, o->height, n,
@@ -253,7 +253,7 @@ static void finish_stats(veil_render_stats* st, veil_render_stats* out)
 {
     st->inject_ms = st->stage[VEIL_STAGE_INJECT].ms;
     st->propagate_ms = st->stage[VEIL_STAGE_PROPAGATE].ms;
-    st->render_ms = st->stage[VEIL_STAGE_MARCH].ms;
+    st->render_ms = st->stage[VEIL_STAGE_RENDER].ms;
     if (out) *out = *st;
 }
 

@@ -1,3 +1,9 @@
 veil_test(test_rbf SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_rbf.c LABELS unit)
 veil_test(test_propagate_homogeneous SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_propagate_homogeneous.c LABELS unit)
 veil_test(test_propagate_accuracy SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_propagate_accuracy.c LABELS "unit;accuracy")
+# The layout's include rules (docs/architecture.md) hold on the tree, and
+# the checker catches each kind of violation on trees made for the purpose.
+add_test(NAME check_layout COMMAND bash ${PROJECT_SOURCE_DIR}/scripts/check-layout.sh ${PROJECT_SOURCE_DIR})
+add_test(NAME check_layout_selftest
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/check_layout_selftest.sh ${PROJECT_SOURCE_DIR}/scripts/check-layout.sh)
+set_tests_properties(check_layout check_layout_selftest PROPERTIES LABELS unit)

@@ -4,11 +4,23 @@ veil_test(test_propagate_gpu SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_propagate_
 veil_test(test_single_scatter SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_single_scatter.c LABELS "gpu;accuracy")
 
 # End to end through the CLI: the demo scene at a small size, gpuinfo, usage.
+# exr_stats (a test tool) checks the values of the files it writes.
+add_executable(exr_stats ${CMAKE_CURRENT_SOURCE_DIR}/exr_stats.c)
+target_include_directories(exr_stats PRIVATE ${OPENEXR_INCLUDE_DIRS})
+target_link_libraries(exr_stats PRIVATE veil veil_fp veil_warnings PkgConfig::PNG ${OPENEXRCORE_LIB})
 add_test(NAME cli_end_to_end
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli_end_to_end.sh $<TARGET_FILE:veil_cli>
-          ${PROJECT_SOURCE_DIR}/data/scenes/demo.json)
+          ${PROJECT_SOURCE_DIR}/data/scenes/demo.json $<TARGET_FILE:exr_stats>)
 set_tests_properties(cli_end_to_end PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)
 veil_test(test_render_cache SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_render_cache.c LABELS gpu)
 # The marcher against closed forms (airlight, a Gaussian's erf, slanted
 # exponential fog) within step-error bounds derived in the test.
 veil_test(test_marcher_closed_forms SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_marcher_closed_forms.c LABELS "gpu;accuracy")
+# The image set's AOVs (T, P, single scattering, depth) against closed forms,
+# and their named EXR channels.
+veil_test(test_image_set SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_image_set.c LABELS "gpu;accuracy")
+# veil render --explain: the plan of a turntable, without a GPU, agreeing
+# with what --stats reports.
+add_test(NAME cli_explain
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli_explain.sh $<TARGET_FILE:veil_cli> ${PROJECT_SOURCE_DIR}/data/scenes)
+set_tests_properties(cli_explain PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)

@@ -11,7 +11,7 @@ set_tests_properties(vdb_generate PROPERTIES FIXTURES_SETUP vdb_data LABELS unit
 
 # test_vdb DATA CASE: one ctest per case (tests/test_vdb.c).
 add_executable(test_vdb ${CMAKE_CURRENT_SOURCE_DIR}/test_vdb.c ${CMAKE_CURRENT_SOURCE_DIR}/check.c)
-target_link_libraries(test_vdb PRIVATE veil veil_warnings)
+target_link_libraries(test_vdb PRIVATE veil veil_fp veil_warnings)
 function(veil_vdb_case name labels)
   add_test(NAME vdb_${name} COMMAND test_vdb ${VDB_DATA} ${name})
   set_tests_properties(vdb_${name} PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "${labels}")
@@ -35,6 +35,9 @@ veil_vdb_case(fast_path "unit;accuracy")
 veil_vdb_case(mass "unit;accuracy")
 veil_vdb_case(rotated "unit;accuracy")
 veil_vdb_case(limits unit)
+# a scene's VDB source: veil_scene_volume_open with err == NULL on a missing
+# and a corrupt file; veil_scene_volume_key is the file's identity, not its bytes
+veil_vdb_case(scene_volume unit)
 
 # `veil info` (tests/vdb_bad.sh VEIL EXPECTED_EXIT EXPECTED_TEXT ARGS...).
 function(veil_vdb_cli name rc text)

@@ -18,7 +18,7 @@
 // function. D_ev is read from the optical-depth volume at X, or, outside the
 // EV's box, where the path to the light enters the box; D_fog is closed form.
 // Empty space: where a brick of the EV and the voxel ring around it hold no
-// density (render/shaders/occupancy.comp) every sample in it would add
+// density (volume/shaders/occupancy.comp) every sample in it would add
 // nothing, so without fog the march jumps to where the ray leaves the brick.
 // Output: rgb = L + T * background, a = 1 - mean(T). With u.limits.x the
 // march ends at the first step boundary at or beyond it (the same steps).

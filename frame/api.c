@@ -1,0 +1,208 @@
+/* veil — the public API (include/veil.h) over the renderer, the scene
+ * reader and the image writers. Every pointer argument is checked here, so
+ * that a caller's NULL is a VEIL_ERR_INVALID naming the argument, never a
+ * crash; the internal functions below assume valid arguments. */
+#include "../include/veil.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/result.h"
+#include "../gpu/gl_context.h"
+#include "../io/image.h"
+#include "../io/scene.h"
+#include "../render/image_set.h"
+#include "../scene/camera.h"
+#include "../scene/scene.h"
+#include "renderer.h"
+#include "stage.h"
+
+struct veil_context {
+    veil_gl* gl;
+    veil_renderer* renderer;
+};
+
+struct veil_image {
+    veil_image_set set;
+    veil_render_stats stats;
+};
+
+#define VEIL__NULL_ARG(fn, arg) veil_fail(err, VEIL_ERR_INVALID, "%s: %s is NULL", fn, arg)
+
+const char* veil_version(void)
+{
+    return VEIL_VERSION;
+}
+
+/* ---- context ------------------------------------------------------------- */
+
+veil_result veil_context_create(const veil_context_desc* desc, veil_context** out, veil_error* err)
+{
+    if (!out) return VEIL__NULL_ARG("veil_context_create", "out");
+    *out = NULL;
+    veil_context_desc d = desc ? *desc : (veil_context_desc){0};
+    veil_context* ctx = calloc(1, sizeof *ctx);
+    if (!ctx) return veil_fail(err, VEIL_ERR_OOM, "veil_context_create: out of memory");
+    veil_gl_desc gd = {.force_software = d.force_software != 0, .debug = d.debug != 0};
+    veil_result r = veil_gl_create(&gd, &ctx->gl, err);
+    if (r == VEIL_OK) r = veil_renderer_create(ctx->gl, &ctx->renderer, err);
+    if (r != VEIL_OK) {
+        veil_context_destroy(ctx);
+        return r;
+    }
+    *out = ctx;
+    return VEIL_OK;
+}
+
+void veil_context_destroy(veil_context* ctx)
+{
+    if (!ctx) return;
+    veil_renderer_destroy(ctx->renderer); /* its GL objects go while the context is current */
+    veil_gl_destroy(ctx->gl);
+    free(ctx);
+}
+
+/* ---- scene --------------------------------------------------------------- */
+
+veil_result veil_scene_open(const char* path, veil_scene** out, veil_error* err)
+{
+    if (!out) return VEIL__NULL_ARG("veil_scene_open", "out");
+    *out = NULL;
+    if (!path) return VEIL__NULL_ARG("veil_scene_open", "path");
+    veil_scene* s = calloc(1, sizeof *s);
+    if (!s) return veil_fail(err, VEIL_ERR_OOM, "veil_scene_open: out of memory");
+    veil_result r = veil_scene_load(path, s, err);
+    if (r != VEIL_OK) {
+        veil_scene_close(s);
+        return r;
+    }
+    *out = s;
+    return VEIL_OK;
+}
+
+void veil_scene_close(veil_scene* scene)
+{
+    if (!scene) return;
+    veil_scene_free(scene);
+    free(scene);
+}
+
+/* ---- render -------------------------------------------------------------- */
+
+static veil_result check_render_desc(const veil_render_desc* d, veil_error* err)
+{
+    if (d->width < 0 || d->height < 0 || d->width > VEIL_SCENE_MAX_IMAGE || d->height > VEIL_SCENE_MAX_IMAGE)
+        return veil_fail(err, VEIL_ERR_INVALID, "veil_render: image size %dx%d is outside 1..%d (0: the scene's)",
+                         d->width, d->height, VEIL_SCENE_MAX_IMAGE);
+    if (!(d->step_voxels >= 0.0f) || !isfinite(d->step_voxels))
+        return veil_fail(err, VEIL_ERR_INVALID, "veil_render: step_voxels %g is not a finite value >= 0 (0: default)",
+                         (double)d->step_voxels);
+    if (d->frames < 0)
+        return veil_fail(err, VEIL_ERR_INVALID, "veil_render: frames %ld is negative", d->frames);
+    long n = d->frames > 1 ? d->frames : 1;
+    if (d->frame < 0 || d->frame >= n)
+        return veil_fail(err, VEIL_ERR_INVALID, "veil_render: frame %ld is outside 0..%ld (frames %ld)", d->frame,
+                         n - 1, d->frames);
+    return VEIL_OK;
+}
+
+veil_result veil_render(veil_context* ctx, const veil_scene* scene, const veil_render_desc* desc, veil_image** out,
+                        veil_error* err)
+{
+    if (!out) return VEIL__NULL_ARG("veil_render", "out");
+    *out = NULL;
+    if (!ctx) return VEIL__NULL_ARG("veil_render", "ctx");
+    if (!scene) return VEIL__NULL_ARG("veil_render", "scene");
+    veil_render_desc d = desc ? *desc : (veil_render_desc){0};
+    veil_result r = check_render_desc(&d, err);
+    if (r != VEIL_OK) return r;
+
+    veil_image* img = calloc(1, sizeof *img);
+    if (!img) return veil_fail(err, VEIL_ERR_OOM, "veil_render: out of memory");
+    veil_camera cam = veil_camera_of_frame(&scene->camera, d.frame, d.frames);
+    veil_render_opts opts = {.width = d.width, .height = d.height, .step_voxels = d.step_voxels,
+                             .seed = d.seed, .camera = &cam};
+    r = veil_render_scene_images(ctx->renderer, scene, &opts, &img->set, &img->stats, err);
+    if (r != VEIL_OK) {
+        veil_image_destroy(img);
+        return r;
+    }
+    *out = img;
+    return VEIL_OK;
+}
+
+/* ---- image --------------------------------------------------------------- */
+
+void veil_image_size(const veil_image* img, int* width, int* height)
+{
+    if (width) *width = img ? img->set.width : 0;
+    if (height) *height = img ? img->set.height : 0;
+}
+
+const float* veil_image_rgba(const veil_image* img)
+{
+    return img ? img->set.rgba : NULL;
+}
+
+veil_result veil_image_channel(const veil_image* img, const char* name, float* out, veil_error* err)
+{
+    if (!img) return VEIL__NULL_ARG("veil_image_channel", "img");
+    if (!name) return VEIL__NULL_ARG("veil_image_channel", "name");
+    if (!out) return VEIL__NULL_ARG("veil_image_channel", "out");
+    for (int c = 0; c < VEIL_IMAGE_SET_CHANNELS; ++c) {
+        if (!strcmp(name, veil_image_set_channel_names[c])) {
+            veil_image_set_plane(&img->set, c, out);
+            return VEIL_OK;
+        }
+    }
+    char list[256] = "";
+    size_t len = 0;
+    for (int c = 0; c < VEIL_IMAGE_SET_CHANNELS && len < sizeof list; ++c) {
+        int n = snprintf(list + len, sizeof list - len, "%s%s", c ? ", " : "", veil_image_set_channel_names[c]);
+        if (n < 0) break;
+        len += (size_t)n;
+    }
+    return veil_fail(err, VEIL_ERR_INVALID, "veil_image_channel: no channel '%.64s'; the channels are %s", name, list);
+}
+
+veil_result veil_image_write_exr(const veil_image* img, const char* path, int aovs, veil_error* err)
+{
+    if (!img) return VEIL__NULL_ARG("veil_image_write_exr", "img");
+    if (!path) return VEIL__NULL_ARG("veil_image_write_exr", "path");
+    return veil_image_set_write_exr(&img->set, path, aovs, err);
+}
+
+veil_result veil_image_write_png(const veil_image* img, const char* path, float exposure, veil_error* err)
+{
+    if (!img) return VEIL__NULL_ARG("veil_image_write_png", "img");
+    if (!path) return VEIL__NULL_ARG("veil_image_write_png", "path");
+    if (!isfinite(exposure))
+        return veil_fail(err, VEIL_ERR_INVALID, "veil_image_write_png: exposure %g is not finite", (double)exposure);
+    return veil_write_png(path, img->set.width, img->set.height, img->set.rgba, exposure, err);
+}
+
+int veil_image_stage_count(const veil_image* img)
+{
+    return img ? VEIL_STAGE_COUNT : 0;
+}
+
+veil_result veil_image_stage(const veil_image* img, int i, const char** name, const char** status, double* ms,
+                             const char** why)
+{
+    if (!img || i < 0 || i >= VEIL_STAGE_COUNT) return VEIL_ERR_INVALID;
+    const veil_stage_report* rep = &img->stats.stage[i];
+    if (name) *name = veil_stage_name((veil_stage_id)i);
+    if (status) *status = veil_stage_status_name(rep->status);
+    if (ms) *ms = rep->ms;
+    if (why) *why = rep->why;
+    return VEIL_OK;
+}
+
+void veil_image_destroy(veil_image* img)
+{
+    if (!img) return;
+    veil_image_set_free(&img->set);
+    free(img);
+}

@@ -1,0 +1,126 @@
+/* veil — headless volumetric rendering: the public C API.
+ *
+ * veil renders participating media (smoke, fog, clouds given as particles,
+ * OpenVDB grids or analytic fogs, lit by point, spot and directional lights)
+ * on the GPU through a headless EGL/OpenGL 4.5 context: a scene file
+ * (JSON, docs/scene-format.md) in, an image of linear radiance and its
+ * arbitrary output variables (transmittance, density integral, single
+ * scattering, depth) out, as floats or as an EXR or PNG file.
+ *
+ * Units: metres, m^-1 for the medium's coefficients, W/sr for point and spot
+ * intensities, W/m^2 for directional irradiance; images hold linear RGBA
+ * floats, row-major, top row first, 4 floats a pixel, A = 1 - mean
+ * transmittance. Ray-march steps are in voxels of the extinction volume.
+ *
+ * Ownership: every handle is opaque, made by a veil_X_create/open/render
+ * call and released by its veil_X_destroy/close (which accept NULL). veil
+ * copies what it keeps and never holds on to a caller's pointer; pointers
+ * it returns (pixels, names, messages) stay valid until the handle they came
+ * from is released.
+ *
+ * Errors: every fallible call returns a veil_result (VEIL_OK is 0) and, when
+ * err is not NULL, writes a sentence saying what went wrong into it. veil
+ * never prints and never exits.
+ *
+ * Threading: a veil_context makes an OpenGL context current on the thread
+ * that creates it; use it (and the images it renders) on that thread only,
+ * one context per thread. Scenes and images hold no GL objects: once made
+ * they can be read from any thread.
+ */
+#ifndef VEIL_H
+#define VEIL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "veil/result.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* "0.1.0": the library's version. */
+const char* veil_version(void);
+
+/* ---- context: a GL context and the renderer's kept stage results ------ */
+
+typedef struct veil_context veil_context;
+
+/* Zero means default in every field. */
+typedef struct veil_context_desc {
+    int force_software; /* 1: software rasteriser only; 0: hardware first (VEIL_DEVICE=software also forces it) */
+    int debug;          /* 1: a GL debug context */
+} veil_context_desc;
+
+/* Creates a headless GL 4.5 context, current on the calling thread, and a
+ * renderer on it (desc may be NULL). VEIL_ERR_GPU when no such context can
+ * be made. A context keeps each stage's results between renders: rendering
+ * a turntable of one scene injects and propagates once. */
+veil_result veil_context_create(const veil_context_desc* desc, veil_context** out, veil_error* err);
+void veil_context_destroy(veil_context* ctx); /* accepts NULL */
+
+/* ---- scene ------------------------------------------------------------- */
+
+typedef struct veil_scene veil_scene;
+
+/* Reads a scene file (relative paths inside resolve against its folder).
+ * VEIL_ERR_IO, VEIL_ERR_PARSE or VEIL_ERR_INVALID with the file and the
+ * JSON path of the offending field. */
+veil_result veil_scene_open(const char* path, veil_scene** out, veil_error* err);
+void veil_scene_close(veil_scene* scene); /* accepts NULL */
+
+/* ---- render ------------------------------------------------------------ */
+
+typedef struct veil_image veil_image;
+
+/* Zero means default in every field. */
+typedef struct veil_render_desc {
+    int width, height;  /* pixels, 1..16384; 0: the scene camera's */
+    float step_voxels;  /* ray-march step in voxels of the extinction volume; 0: 0.5 */
+    uint32_t seed;      /* jitter seed: the same seed renders the same image */
+    long frame, frames; /* frames > 1: frame `frame` (0..frames-1) of a turntable, one full
+                           turn about the camera's up axis through its look-at point in
+                           `frames` equal steps (frame 0: the scene's camera);
+                           0 or 1: the scene's camera (frame must be 0) */
+} veil_render_desc;
+
+/* Renders scene with ctx (desc may be NULL) into a new image (*out; free
+ * it with veil_image_destroy). */
+veil_result veil_render(veil_context* ctx, const veil_scene* scene, const veil_render_desc* desc,
+                        veil_image** out, veil_error* err);
+
+/* ---- image --------------------------------------------------------------- */
+
+void veil_image_size(const veil_image* img, int* width, int* height); /* 0x0 for NULL */
+
+/* width*height*4 floats: linear R, G, B and A, top row first; owned by img. */
+const float* veil_image_rgba(const veil_image* img);
+
+/* One channel as a width*height plane into out (the caller's). Names:
+ * "R", "G", "B", "A", "T.R", "T.G", "T.B" (transmittance), "P" (density
+ * integral), "single.R", "single.G", "single.B" (single scattering),
+ * "depth" (mean distance of the first interaction, m). VEIL_ERR_INVALID
+ * for any other name. */
+veil_result veil_image_channel(const veil_image* img, const char* name, float* out, veil_error* err);
+
+/* EXR, 32-bit float, ZIP: R, G, B, A, plus every other channel above when
+ * aovs is non-zero. All or nothing: a failed write leaves no file. */
+veil_result veil_image_write_exr(const veil_image* img, const char* path, int aovs, veil_error* err);
+
+/* 8-bit sRGB PNG preview of the radiance times 2^exposure, tone-mapped. */
+veil_result veil_image_write_png(const veil_image* img, const char* path, float exposure, veil_error* err);
+
+/* The render's stage reports ("inject", "propagate", "render"), in order:
+ * what each did ("ran", "cached", "skipped"), its wall time (ms) and why.
+ * Each output may be NULL; the strings are owned by img (names: static). */
+int veil_image_stage_count(const veil_image* img); /* 0 for NULL */
+veil_result veil_image_stage(const veil_image* img, int i, const char** name, const char** status, double* ms,
+                             const char** why);
+
+void veil_image_destroy(veil_image* img); /* accepts NULL */
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
