@@ -124,13 +124,7 @@ veil_result veil_plan_explain(const veil_scene* s, const veil_render_opts* opts,
     } else if (n == 0) {
         put(&t, "propagate  skipped on every frame: no light reaches the medium\n");
     } else {
-        float st_max = 0.0f;
-        for (int c = 0; c < 3; ++c) {
-            float st = s->medium.sigma_a[c] + s->medium.sigma_s[c];
-            st_max = st > st_max ? st : st_max;
-        }
-        veil_opv_params params = {.method = o.method,
-                                  .tolerance = st_max > 0.0f ? VEIL_OPV_TAU_TOLERANCE / st_max : 3.0e38f};
+        veil_opv_params params = veil_render_opv_params(s, o.method);
         put(&t, "propagate  frame 0: runs, %d light%s (%s), %d texture%s:", n, n == 1 ? "" : "s",
             veil_opv_method_name(o.method), (n + 3) / 4, (n + 3) / 4 == 1 ? "" : "s");
         for (int tex = 0; 4 * tex < n; ++tex) {

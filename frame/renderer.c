@@ -166,6 +166,15 @@ static veil_result inject_scene(veil_renderer* r, const veil_scene* s, veil_rend
 
 /* ---- stage 2: propagate ------------------------------------------------ */
 
+veil_opv_params veil_render_opv_params(const veil_scene* s, veil_opv_method method)
+{
+    float st_max = 0.0f;
+    for (int c = 0; c < 3; ++c) st_max = fmaxf(st_max, s->medium.sigma_a[c] + s->medium.sigma_s[c]);
+    /* D changes of tol move tau by at most st_max * tol */
+    return (veil_opv_params){.method = veil_opv_method_resolve(method),
+                             .tolerance = st_max > 0.0f ? VEIL_OPV_TAU_TOLERANCE / st_max : INFINITY};
+}
+
 static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_light* lights, int n,
                              const veil_render_opts* o, veil_render_stats* st, veil_error* err)
 {
@@ -181,11 +190,7 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
         why(rep, "no light reaches the medium (of %zu)", s->light_count);
         return VEIL_OK;
     }
-    float st_max = 0.0f;
-    for (int c = 0; c < 3; ++c) st_max = fmaxf(st_max, s->medium.sigma_a[c] + s->medium.sigma_s[c]);
-    /* D changes of tol move tau by at most st_max * tol */
-    veil_opv_params params = {.method = o->method,
-                              .tolerance = st_max > 0.0f ? VEIL_OPV_TAU_TOLERANCE / st_max : INFINITY};
+    veil_opv_params params = veil_render_opv_params(s, o->method);
     veil_opv_report orep = {0};
     veil_result res = veil_opv_set_update(r->opv, g, veil_ev_texture(r->ev), r->ev_key, lights, n, &params, &orep, err);
     st->opv_computed = orep.computed;

@@ -100,6 +100,10 @@ veil_result veil_render_density(veil_renderer* r, const veil_scene* s, const vei
  * does; a spot whose outer cone misses the box's bounding sphere does not. */
 int veil_render_lights(const veil_scene* s, const veil_grid* g, veil_light* out);
 
+/* The propagation parameters for s: the method, and the Jacobi tolerance
+ * on D that keeps sigma_t D within VEIL_OPV_TAU_TOLERANCE. */
+veil_opv_params veil_render_opv_params(const veil_scene* s, veil_opv_method method);
+
 /* Stage access for tests: GPU splat read back (veil_grid_voxels floats) and
  * GPU propagation read back (n_lights * voxels floats, light-major). */
 veil_result veil_renderer_inject(veil_renderer* r, const veil_grid* g, const veil_particle* p, size_t n,

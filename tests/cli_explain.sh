@@ -24,7 +24,7 @@ GALLIUM_DRIVER=nope VEIL_DEVICE=software "$veil" render "$scenes/demo.json" --ex
   || fail "explain needed a GL context"
 ok
 
-# the keys it prints are the ones the renderer reports
+# what it plans is what the renderer then does and reports
 "$veil" render "$scenes/demo.json" -o "$tmp/a.exr" --width 32 --height 24 --turntable 2 --stats > "$tmp/stats.txt"
 rc=$?
 if [ $rc = 3 ] && [ "${CI:-}" != true ]; then echo "skipped: no GL 4.5 context"; exit 77; fi
