@@ -1,4 +1,4 @@
-/* veil compare A.exr REF.exr [--heatmap OUT.png] [--floor F] [--json]
+/* veil compare A.exr REF.exr [--heatmap OUT.png] [--floor F] [--bin B] [--json]
  *
  * Compares image A against the reference REF (reference/compare.h has the
  * metrics) and prints them, one a line (`rel_rmse 0.0123 (floor ...)`), or
@@ -6,6 +6,16 @@
  *   {"image", "reference": paths, "width", "height", "floor", "rel_rmse",
  *    "rmse", "max_abs", "off_5pct", "psnr_db", "alpha_max_abs",
  *    "heatmap": path or null}
+ * plus "bin", "mean_bias" and, when REF holds the standard errors that
+ * `veil reference` writes (stderr.R, .G, .B), "noise" and
+ * "rel_rmse_excess" (null without them).
+ * --bin B compares the means of B x B pixel blocks (a partial block at an
+ * edge dropped): the reference's noise falls B times, systematic errors
+ * stay. mean_bias = mean(A RGB) / mean(REF RGB) - 1. noise is the rms of
+ * the reference's standard error relative to it (same floor, binned
+ * alike); rel_rmse_excess = sqrt(max(0, rel_rmse^2 - noise^2)) is the
+ * image's own error with the reference's noise taken out (they add in
+ * quadrature, being independent).
  * Numbers are JSON numbers; "psnr_db" is null when the images' RGB are
  * identical (MSE 0, PSNR infinite; the text form prints "inf"). No NaN is
  * ever printed: every other number is finite for finite inputs.
@@ -35,6 +45,7 @@ typedef struct compare_args {
     const char *image, *reference, *heatmap;
     double floor; /* 0: the default */
     int json;
+    int bin;      /* 1: per pixel */
 } compare_args;
 
 /* A number (strtod syntax), positive and finite. */
@@ -52,11 +63,20 @@ static int parse_positive(const char* s, double* out)
 static int parse_args(int argc, char** argv, compare_args* a)
 {
     memset(a, 0, sizeof *a);
+    a->bin = 1;
     for (int i = 2; i < argc; ++i) {
         const char* s = argv[i];
         const char* v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(s, "--json")) {
             a->json = 1;
+        } else if (!strcmp(s, "--bin")) {
+            char* end;
+            long b = v ? strtol(v, &end, 10) : 0;
+            if (!v) return veil_cli_usage_error("%s needs a value", s);
+            if (*v == 0 || *end || b < 1 || b > 4096)
+                return veil_cli_usage_error("--bin: expected an integer in 1..4096 (pixels a side), got '%s'", v);
+            a->bin = (int)b;
+            ++i;
         } else if (!strcmp(s, "--heatmap") || !strcmp(s, "--floor")) {
             if (!v) return veil_cli_usage_error("%s needs a value", s);
             ++i;
@@ -104,7 +124,11 @@ static void print_json_number(const char* key, double v, const char* after)
     fputs(after, stdout);
 }
 
-static void print_json(const compare_args* a, const veil_compare_stats* st)
+typedef struct extra_stats {
+    double bias, noise, excess; /* noise, excess: NAN without standard errors */
+} extra_stats;
+
+static void print_json(const compare_args* a, const veil_compare_stats* st, const extra_stats* x)
 {
     fputs("{\n  \"image\": ", stdout);
     print_json_string(a->image);
@@ -118,6 +142,10 @@ static void print_json(const compare_args* a, const veil_compare_stats* st)
     print_json_number("off_5pct", st->frac_off, ",\n");
     print_json_number("psnr_db", st->psnr_db, ",\n");
     print_json_number("alpha_max_abs", st->alpha_max_abs, ",\n");
+    printf("  \"bin\": %d,\n", a->bin);
+    print_json_number("mean_bias", x->bias, ",\n");
+    print_json_number("noise", x->noise, ",\n");
+    print_json_number("rel_rmse_excess", x->excess, ",\n");
     fputs("  \"heatmap\": ", stdout);
     if (a->heatmap) print_json_string(a->heatmap);
     else fputs("null", stdout);
@@ -132,7 +160,7 @@ static void decade(double v, char out[16])
     else snprintf(out, 16, "1e%ld", e);
 }
 
-static void print_text(const compare_args* a, const veil_compare_stats* st)
+static void print_text(const compare_args* a, const veil_compare_stats* st, const extra_stats* x)
 {
     printf("image          %s\n", a->image);
     printf("reference      %s (%dx%d)\n", a->reference, st->width, st->height);
@@ -144,6 +172,11 @@ static void print_text(const compare_args* a, const veil_compare_stats* st)
     if (isfinite(st->psnr_db)) printf("psnr_db        %.6g (peak: the reference's largest RGB value)\n", st->psnr_db);
     else printf("psnr_db        inf (identical RGB)\n");
     printf("alpha_max_abs  %.6g\n", st->alpha_max_abs);
+    if (a->bin > 1) printf("bin            %d (means of %dx%d pixel blocks)\n", a->bin, a->bin, a->bin);
+    printf("mean_bias      %+.6g (mean RGB / reference's - 1)\n", x->bias);
+    if (isfinite(x->noise))
+        printf("noise          %.6g (reference's standard error, relative)\nrel_rmse_excess %.6g (noise taken out)\n",
+               x->noise, x->excess);
     if (a->heatmap) {
         char lo[16], hi[16], blue[16], magenta[16], yellow[16];
         decade(VEIL_COMPARE_HEATMAP_MIN, lo), decade(VEIL_COMPARE_HEATMAP_MAX, hi);
@@ -186,6 +219,39 @@ int veil_cmd_compare(int argc, char** argv)
             r = veil_fail(&err, VEIL_ERR_OOM, "%s: out of memory for a %dx%d heatmap", a.heatmap, wa, ha);
     }
     veil_compare_stats st = {0};
+    extra_stats x = {0.0, NAN, NAN};
+    float* se = NULL;
+    if (r == VEIL_OK) {
+        /* the reference's standard errors, when it has them */
+        static const char* const names[3] = {"stderr.R", "stderr.G", "stderr.B"};
+        veil_error ignored = {0};
+        for (int c = 0; c < 3; ++c) {
+            int w = 0, h = 0;
+            float* plane = NULL;
+            if (veil_read_exr_channel(a.reference, names[c], &w, &h, &plane, &ignored) != VEIL_OK || w != wa ||
+                h != ha) {
+                free(plane);
+                free(se);
+                se = NULL;
+                break;
+            }
+            if (!se && !(se = malloc((size_t)wa * (size_t)ha * 3 * sizeof *se))) {
+                free(plane);
+                break;
+            }
+            for (size_t i = 0; i < (size_t)wa * (size_t)ha; ++i) se[3 * i + (size_t)c] = plane[i];
+            free(plane);
+        }
+    }
+    if (r == VEIL_OK && a.bin > 1) {
+        if (a.heatmap) r = veil_fail(&err, VEIL_ERR_INVALID, "--heatmap is per pixel: leave out --bin");
+        float *bi = NULL, *br = NULL, *bse = NULL;
+        if (r == VEIL_OK) r = veil_compare_bin(img, NULL, wa, ha, a.bin, &bi, NULL, &err);
+        if (r == VEIL_OK) r = veil_compare_bin(ref, se, wa, ha, a.bin, &br, se ? &bse : NULL, &err);
+        free(img), free(ref), free(se);
+        img = bi, ref = br, se = bse;
+        wa /= a.bin, ha /= a.bin;
+    }
     if (r == VEIL_OK) {
         r = veil_compare_images(img, ref, wa, ha, a.floor, &st, rel, &err);
         if (r != VEIL_OK) {
@@ -195,13 +261,22 @@ int veil_cmd_compare(int argc, char** argv)
             memcpy(err.msg, tmp, sizeof tmp);
         }
     }
+    if (r == VEIL_OK) {
+        x.bias = veil_compare_bias(img, ref, wa, ha);
+        if (se) {
+            x.noise = veil_compare_noise(ref, se, wa, ha, st.floor);
+            double e = st.rel_rmse * st.rel_rmse - x.noise * x.noise;
+            x.excess = e > 0.0 ? sqrt(e) : 0.0;
+        }
+    }
     if (r == VEIL_OK && a.heatmap) r = write_heatmap(a.heatmap, wa, ha, rel, &err);
+    free(se);
     free(img);
     free(ref);
     free(rel);
     if (r != VEIL_OK) return veil_cli_fail(r, &err);
 
-    if (a.json) print_json(&a, &st);
-    else print_text(&a, &st);
+    if (a.json) print_json(&a, &st, &x);
+    else print_text(&a, &st, &x);
     return EXIT_OK;
 }

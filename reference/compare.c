@@ -125,3 +125,65 @@ void veil_compare_heatmap_colour(double rel, unsigned char rgb[3])
         rgb[c] = (unsigned char)floorf(v * 255.0f + 0.5f);
     }
 }
+
+veil_result veil_compare_bin(const float* rgba, const float* se, int w, int h, int b, float** out, float** se_out,
+                             veil_error* err)
+{
+    *out = NULL;
+    if (se_out) *se_out = NULL;
+    if (b < 1 || b > w || b > h)
+        return veil_fail(err, VEIL_ERR_INVALID, "bin size %d: expected 1..%d (the smaller side)", b, w < h ? w : h);
+    int bw = w / b, bh = h / b;
+    float* o = malloc((size_t)bw * (size_t)bh * 4 * sizeof *o);
+    float* so = se && se_out ? malloc((size_t)bw * (size_t)bh * 3 * sizeof *so) : NULL;
+    if (!o || (se && se_out && !so)) {
+        free(o);
+        free(so);
+        return veil_fail(err, VEIL_ERR_OOM, "out of memory binning a %dx%d image", w, h);
+    }
+    for (int by = 0; by < bh; ++by)
+        for (int bx = 0; bx < bw; ++bx) {
+            double sum[4] = {0, 0, 0, 0}, var[3] = {0, 0, 0};
+            for (int y = by * b; y < (by + 1) * b; ++y)
+                for (int x = bx * b; x < (bx + 1) * b; ++x) {
+                    size_t i = (size_t)y * (size_t)w + (size_t)x;
+                    for (int c = 0; c < 4; ++c) sum[c] += rgba[4 * i + (size_t)c];
+                    if (so)
+                        for (int c = 0; c < 3; ++c) var[c] += (double)se[3 * i + (size_t)c] * se[3 * i + (size_t)c];
+                }
+            size_t k = (size_t)by * (size_t)bw + (size_t)bx;
+            double n = (double)b * b;
+            for (int c = 0; c < 4; ++c) o[4 * k + (size_t)c] = (float)(sum[c] / n);
+            if (so)
+                for (int c = 0; c < 3; ++c) so[3 * k + (size_t)c] = (float)(sqrt(var[c]) / n);
+        }
+    *out = o;
+    if (se_out) *se_out = so;
+    return VEIL_OK;
+}
+
+double veil_compare_bias(const float* a, const float* b, int width, int height)
+{
+    double sa = 0.0, sb = 0.0;
+    size_t n = (size_t)width * (size_t)height;
+    for (size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 3; ++c) {
+            sa += a[4 * i + (size_t)c];
+            sb += b[4 * i + (size_t)c];
+        }
+    if (sb == 0.0) return sa == 0.0 ? 0.0 : FLT_MAX;
+    return sa / sb - 1.0;
+}
+
+double veil_compare_noise(const float* b, const float* se, int width, int height, double floor)
+{
+    double sum = 0.0;
+    size_t n = (size_t)width * (size_t)height;
+    for (size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 3; ++c) {
+            double d = fmax(fabs((double)b[4 * i + (size_t)c]), floor);
+            double r = se[3 * i + (size_t)c] / d;
+            sum += r * r;
+        }
+    return n ? sqrt(sum / (3.0 * (double)n)) : 0.0;
+}

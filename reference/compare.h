@@ -61,6 +61,26 @@ typedef struct veil_compare_stats {
 veil_result veil_compare_images(const float* a, const float* b, int width, int height, double floor,
                                 veil_compare_stats* out, float* rel_err, veil_error* err);
 
+/* Means of b x b pixel blocks of an RGBA image (a partial block at the
+ * right or bottom edge is dropped), into a newly malloc'd (w/b) x (h/b)
+ * image; with se (3 floats a pixel, per-pixel standard errors, may be
+ * NULL) also the blocks' standard errors sqrt(sum se^2) / b^2 into *se_out
+ * (3 floats a block). NULL (and VEIL_ERR_*) when b < 1, b exceeds a side,
+ * or out of memory. */
+veil_result veil_compare_bin(const float* rgba, const float* se, int w, int h, int b, float** out, float** se_out,
+                             veil_error* err);
+
+/* Mean energy bias of a against the reference b: mean(a RGB) / mean(b RGB)
+ * - 1 (0 when both are black; +inf as a huge number: FLT_MAX, when only b is). */
+double veil_compare_bias(const float* a, const float* b, int width, int height);
+
+/* The reference's own noise on the scale of the relative RMSE: the rms
+ * over pixels and channels of se / max(|b|, floor). A measured rel_rmse
+ * holds this noise in quadrature (the reference's error is independent of
+ * the image's), so sqrt(max(0, rel_rmse^2 - noise^2)) is the image's own
+ * error, noise-debiased. */
+double veil_compare_noise(const float* b, const float* se, int width, int height, double floor);
+
 /* The heatmap colour of a relative error: 8-bit sRGB-encoded RGB. The stops
  * are interpolated in linear light, so the luminance rises monotonically
  * with the error (black 0 < blue < magenta < yellow < white 1). NaN maps
