@@ -5,6 +5,7 @@
 #define VEIL_CLI_COMMANDS_H
 
 int veil_cmd_compare(int argc, char** argv);
+int veil_cmd_fog(int argc, char** argv);
 int veil_cmd_gpuinfo(int argc, char** argv);
 int veil_cmd_info(int argc, char** argv);
 int veil_cmd_rbf(int argc, char** argv);

@@ -25,7 +25,9 @@ static const char* usage_text =
     "                   [--stats] [--explain]\n"
     "       veil reference SCENE.json -o REF.exr --spp N [--max-order K] [--width W]\n"
     "                [--height H] [--seed N] [--threads T]\n"
-    "       veil compare A.exr REF.exr [--heatmap OUT.png] [--floor F] [--json]\n"
+    "       veil compare A.exr REF.exr [--heatmap OUT.png] [--floor F] [--bin B] [--json]\n"
+    "       veil fog FRAME.exr --scene SCENE.json -o OUT.exr [--png OUT.png]\n"
+    "                [--depth-channel NAME] [--depth-is z|distance] [--aovs] [--stats]\n"
     "       veil gpuinfo\n"
     "       veil info FILE.vdb [--json]\n"
     "       veil rbf generate -o OUT --count N --seed S --bounds x0,y0,z0,x1,y1,z1\n"
@@ -63,11 +65,20 @@ static const char* usage_text =
     "  --threads T    worker threads (default: one per core)\n"
     "compare  compares image A against reference REF (both EXR, same size): relative\n"
     "         RMSE (denominator floored at --floor, default 1% of REF's mean), max abs\n"
-    "         error, fraction of pixels more than 5% off, PSNR.\n"
+    "         error, fraction of pixels more than 5% off, PSNR, mean bias (mean RGB /\n"
+    "         REF's - 1); with REF's stderr channels also its noise and the error with\n"
+    "         that noise taken out (rel_rmse_excess).\n"
+    "  --bin B        compare means of BxB pixel blocks (the reference's noise falls B x)\n"
     "  --floor F      the denominator's floor, absolute (default 1% of REF's mean RGB)\n"
     "  --heatmap OUT.png  per-pixel relative error as a colour map, log scale:\n"
     "                 black 1e-4 (and 0), blue 1e-3, magenta 1e-2, yellow 1e-1, white 1\n"
     "  --json         print the numbers as JSON (psnr_db null for identical RGB)\n"
+    "fog      adds the scene's medium to a frame rendered elsewhere with the scene's\n"
+    "         camera: FRAME's surfaces are attenuated, glow and blur through the medium\n"
+    "         (screen-space multiple scattering), lit medium in front of them added.\n"
+    "  --depth-channel NAME  the depth channel (default: the first of Z, depth.Z,\n"
+    "                 depth, distance); +inf where nothing was hit\n"
+    "  --depth-is z|distance  depth along the view axis (default) or along the ray\n"
     "gpuinfo  prints the EGL platform and device, GL vendor, renderer, version and\n"
     "         the largest 3D texture. VEIL_DEVICE=software forces llvmpipe.\n"
     "info     lists the grids of an OpenVDB file: name, class, value type, active\n"
@@ -104,6 +115,7 @@ int main(int argc, char** argv)
     if (!strcmp(cmd, "rbf")) return veil_cmd_rbf(argc, argv);
     if (!strcmp(cmd, "reference")) return veil_cmd_reference(argc, argv);
     if (!strcmp(cmd, "compare")) return veil_cmd_compare(argc, argv);
+    if (!strcmp(cmd, "fog")) return veil_cmd_fog(argc, argv);
     if (!strcmp(cmd, "gpuinfo")) return veil_cmd_gpuinfo(argc, argv);
     return veil_cli_usage_error("unknown command '%s'", cmd);
 }

@@ -15,6 +15,7 @@
 #define VEIL_EXPF exp
 #define VEIL_POWF pow
 #define VEIL_SQRTF sqrt
+#define VEIL_LOG2F log2
 #define VEIL_ABSF abs
 #define VEIL_FLOORF floor
 #define VEIL_MINF min
@@ -35,6 +36,7 @@
 #define VEIL_EXPF expf
 #define VEIL_POWF powf
 #define VEIL_SQRTF sqrtf
+#define VEIL_LOG2F log2f
 #define VEIL_ABSF fabsf
 #define VEIL_FLOORF floorf
 #define VEIL_MINF fminf
@@ -102,10 +104,13 @@
 #define VEIL_IMAGE_OUT 3        /* image unit: rgba32f output image (march: radiance, alpha) */
 #define VEIL_IMAGE_AOV_T 4      /* image unit: rgba32f march AOV: transmittance rgb, P */
 #define VEIL_IMAGE_AOV_S 5      /* image unit: rgba32f march AOV: single scattering rgb, depth */
+#define VEIL_IMAGE_AOV_V 6      /* image unit: rgba32f march AOV: volumetric multiple scattering rgb */
+#define VEIL_IMAGE_AOV_Q 7      /* image unit: rgba32f march AOV: single scattering's out-scattered rgb, its P */
 #define VEIL_UBO_MARCH 0        /* uniform block: veil_march_block */
 #define VEIL_TEX_EV 0           /* texture unit: sampled EV */
 #define VEIL_TEX_OPV0 1         /* texture units 1..4: sampled OPVs */
 #define VEIL_TEX_OCC 5          /* texture unit: occupancy bricks (max density per brick) */
+#define VEIL_TEX_LIMIT 6        /* texture unit: r32f per-pixel distance where the ray ends (veil fog) */
 
 /* A light as the GPU sees it: one shape for every shader (std140, 48 bytes).
  * Filled from scene/scene.h's veil_light by veil_gpu_light_from(). */
@@ -140,10 +145,79 @@ VEIL_STRUCT_BEGIN(veil_march_block)
     VEIL_V4(march);        /* x: step (m), y: floor on |S - X|^2 (m^2), z: voxel (m), w: HG g */
     VEIL_V4(limits);       /* x: no step starts at or beyond this distance (m; 3e38: no limit) */
     VEIL_IV4(size);        /* x, y: image size (pixels); z: lights; w: fogs */
-    VEIL_UV4(flags);       /* x: has a volume, y: skip empty bricks, z: jitter seed */
+    VEIL_UV4(flags);       /* x: has a volume, y: skip empty bricks, z: jitter seed, w: per-pixel end */
+    VEIL_V4(octave);       /* volumetric multiple scattering: x: a, y: b, z: c, w: octaves (0: off) */
     veil_gpu_light lights[VEIL_MAX_LIGHTS];
     veil_gpu_fog fogs[VEIL_MAX_FOGS];
 VEIL_STRUCT_END(veil_march_block)
+
+/* ---- screen-space multiple scattering (render/spread.h) ---------------- */
+
+#define VEIL_SPREAD_GROUP 8     /* 8x8 pixels per work group, every spread pass */
+#define VEIL_SPREAD_MAX_LEVEL 12 /* K <= 12: a texel of level 12 spans 4096 pixels */
+/* Image units of the spread passes (their programs bind nothing else). */
+#define VEIL_SPREAD_IN_L 0      /* rgba32f: input radiance L behind the medium */
+#define VEIL_SPREAD_IN_T 1      /* rgba32f: T rgb, P (the march's aov_t) */
+#define VEIL_SPREAD_IN_S 2      /* rgba32f: single rgb, depth (the march's aov_s) */
+#define VEIL_SPREAD_IN_Q 3      /* rgba32f: out-scattered single rgb, its P (the march's aov_q) */
+#define VEIL_SPREAD_OUT_SC 4    /* rgba32f: chain L_sc rgb, W (pixels) */
+#define VEIL_SPREAD_OUT_P 5     /* rgba32f: chain P, P * s (s: pixels per metre), -, - */
+#define VEIL_SPREAD_OUT_SSC 6   /* rgba32f: chain L_ssc rgb, P_ssc */
+#define VEIL_SPREAD_OUT 7       /* rgba32f: the spread light rgb, a: the level read */
+/* Texture units of the spread passes: the chains, sampled. */
+#define VEIL_SPREAD_TEX_SC 0
+#define VEIL_SPREAD_TEX_P 1
+#define VEIL_SPREAD_TEX_SSC 2
+#define VEIL_UBO_SPREAD 1
+/* Interpolation of the chains (paper's Table 1). */
+#define VEIL_INTERP_LINEAR_BILINEAR 0 /* linear between levels, bilinear in a level */
+#define VEIL_INTERP_LINEAR_BICUBIC 1  /* linear between levels, cubic B-spline in a level (4 bilinear taps) */
+#define VEIL_INTERP_CUBIC_BICUBIC 2   /* cubic B-spline between levels too */
+
+VEIL_STRUCT_BEGIN(veil_spread_block)
+    VEIL_V4(sigma_a);    /* rgb: C_a, m^-1 per unit density; w: their mean */
+    VEIL_V4(sigma_s);    /* rgb: C_s, m^-1 per unit density; w: their mean */
+    VEIL_V4(params);     /* x: c (pixels), y: mask epsilon, z: HG g, w: radians per pixel at the centre */
+    VEIL_V4(sep);        /* x: T_y, y: eps_y (radiance), z: T_d', w: eps_d' (density m) */
+    VEIL_V4(weights_lo); /* filter taps 0..3 */
+    VEIL_V4(weights_hi); /* x, y: filter taps 4, 5; z: the separated chain's level; w: - */
+    VEIL_IV4(size);      /* x, y: the image; z, w: level 0 of the chains (padded to a multiple of 2^K) */
+    VEIL_IV4(mode);      /* x: filter taps (2, 4, 6); y: veil_spread_interp; z: K; w: the level being built */
+    VEIL_UV4(flags);     /* x: mask, y: luminance weighting, z: density blur, w: separation */
+VEIL_STRUCT_END(veil_spread_block)
+
+/* Premoze et al. (2004), Iser & Elek (2018) Eq. 1-3: the standard deviation
+ * (m) of the Gaussian spread of a pencil of light over a path whose
+ * density integral is s (density m; the "density-scaled distance" with the
+ * reference medium of unit density), with scattering sa, ss (m^-1 per unit
+ * density) and HG asymmetry g:
+ *   W^2 = 1 / (2 (2 sa / (3 s) + 4 / (s^3 ss (1 - g))))
+ *       = k s / (8 / s^2 + (4/3) sa k),   k = ss (1 - g).
+ * The second form has no division by zero and no 0/0: s -> 0 gives 0
+ * (8/s^2 -> inf), ss -> 0 or g -> 1 gives k = 0 and 0, sa -> 0 gives
+ * s^(3/2) sqrt(k/8); large s saturates at sqrt(3 s / (4 sa)) (inf only where
+ * s or k s is). Inputs must not be NaN; g is clamped to [-1, 1]. */
+VEIL_FN float veil_spread_width(float s, float sa, float ss, float g)
+{
+    float k = ss * (1.0 - VEIL_MINF(VEIL_MAXF(g, -1.0), 1.0));
+    float s2 = s * s; /* s^2 = 0 (underflow, s < 1e-19) would divide by zero: W is 0 there */
+    if (!(s2 > 0.0) || !(k > 0.0)) return 0.0;
+    return VEIL_SQRTF(k * s / (8.0 / s2 + VEIL_FLOAT(4.0 / 3.0) * sa * k));
+}
+
+/* The MIP level whose blur matches a spread of w pixels (Elek et al.
+ * 2013): k = clamp(log2(w / c), 0, K). w <= c (and w = 0) is level 0; inf
+ * is K. */
+VEIL_FN float veil_spread_level(float w, float c, float K)
+{
+    if (!(w > c)) return 0.0;
+    return VEIL_MINF(VEIL_LOG2F(w / c), K);
+}
+
+/* Relative luminance of linear RGB (Rec. 709 primaries). */
+#define VEIL_LUM_R 0.2126
+#define VEIL_LUM_G 0.7152
+#define VEIL_LUM_B 0.0722
 
 /* Henyey–Greenstein phase function (sr^-1), cos_theta the cosine between the
  * light's travel direction and the scattered direction; g = 0 is isotropic

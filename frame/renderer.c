@@ -9,6 +9,7 @@
 #include "../core/clock.h"
 #include "../core/hash.h"
 #include "../propagate/opv_set.h"
+#include "../render/spread.h"
 #include "../volume/ev.h"
 
 struct veil_renderer {
@@ -16,6 +17,7 @@ struct veil_renderer {
     veil_ev* ev;
     veil_opv_set* opv;
     veil_march* march;
+    veil_spread* spread;
     /* what the EV holds: the inject key it was made with (ev_keyed: a key
      * is held, an empty medium included), and for the report */
     uint64_t ev_key;
@@ -34,6 +36,7 @@ veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_er
     veil_result res = veil_ev_create(&r->ev, err);
     if (res == VEIL_OK) res = veil_opv_set_create(&r->opv, err);
     if (res == VEIL_OK) res = veil_march_create(&r->march, err);
+    if (res == VEIL_OK) res = veil_spread_create(&r->spread, err);
     if (res != VEIL_OK) {
         veil_renderer_destroy(r);
         return res;
@@ -48,6 +51,7 @@ void veil_renderer_destroy(veil_renderer* r)
     veil_ev_destroy(r->ev);
     veil_opv_set_destroy(r->opv);
     veil_march_destroy(r->march);
+    veil_spread_destroy(r->spread);
     free(r);
 }
 
@@ -212,6 +216,44 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
     return res;
 }
 
+/* ---- stage 4: screen-space multiple scattering ------------------------ */
+
+static veil_result spread(veil_renderer* r, const veil_scene* s, const veil_render_opts* o, veil_image_set* im,
+                          veil_render_stats* st, veil_error* err)
+{
+    veil_stage_report* rep = &st->stage[VEIL_STAGE_SPREAD];
+    const veil_multiple* m = &s->multiple;
+    if (!m->screen_space) {
+        rep->status = VEIL_STAGE_SKIPPED;
+        why(rep, "off in the scene (multiple_scattering.screen_space)");
+        return VEIL_OK;
+    }
+    float thick = veil_spread_max_scattering(s, im->aov_t, im->aov_q, im->width, im->height);
+    if (!(thick >= m->thin_threshold)) {
+        rep->status = VEIL_STAGE_SKIPPED;
+        why(rep, "optically thin view: max P sigma_s = %.3g < thin_threshold %g", thick, m->thin_threshold);
+        return VEIL_OK;
+    }
+    size_t floats = (size_t)im->width * (size_t)im->height * 4;
+    im->aov_m = malloc(floats * sizeof(float));
+    if (!im->aov_m) return veil_fail(err, VEIL_ERR_OOM, "out of memory for the spread image");
+    veil_spread_input in = {.width = im->width, .height = im->height, .L = o->behind,
+                            .background = {s->background[0], s->background[1], s->background[2]},
+                            .aov_t = im->aov_t, .aov_s = im->aov_s, .aov_q = im->aov_q,
+                            .fov_y_deg = o->camera->fov_y_deg};
+    veil_spread_report sr = {0};
+    veil_result res = veil_spread_run(r->spread, s, &in, im->aov_m, NULL, &sr, err);
+    if (res != VEIL_OK) return res;
+    for (size_t i = 0; i < floats; i += 4)
+        for (int c = 0; c < 3; ++c) im->rgba[i + (size_t)c] += im->aov_m[i + (size_t)c];
+    rep->ms = sr.ms;
+    rep->status = VEIL_STAGE_RAN;
+    why(rep, "max P sigma_s = %.3g >= %g: %d levels on %dx%d, %s filter: depends on the camera", thick,
+        m->thin_threshold, sr.levels, sr.padded_width, sr.padded_height,
+        m->filter == VEIL_SPREAD_2X2 ? "2x2" : m->filter == VEIL_SPREAD_6X6 ? "6x6" : "4x4");
+    return VEIL_OK;
+}
+
 /* ---- stage 3: march, and the frame ------------------------------------- */
 
 static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const veil_render_opts* o,
@@ -244,13 +286,21 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
                           .lights = lights, .light_count = n, .grid = g,
                           .ev = veil_ev_texture(r->ev), .occupancy = veil_ev_occupancy(r->ev), .opv = opv,
                           .step_voxels = o->step_voxels, .seed = o->seed, .skip_empty = !o->no_skip,
-                          .max_distance = o->max_distance};
+                          .max_distance = o->max_distance, .end_distance = o->behind_distance,
+                          .no_background = o->behind != NULL};
     res = veil_march_run(r->march, &md, images, err);
+    if (res == VEIL_OK && o->behind) { /* what is behind, attenuated: T L */
+        size_t pixels = (size_t)images->width * (size_t)images->height;
+        for (size_t i = 0; i < pixels; ++i)
+            for (int c = 0; c < 3; ++c) images->rgba[4 * i + c] += images->aov_t[4 * i + c] * o->behind[4 * i + c];
+    }
     veil_stage_report* rep = &st->stage[VEIL_STAGE_RENDER];
     rep->ms = veil_now_ms() - t1;
     rep->status = VEIL_STAGE_RAN;
-    why(rep, "%dx%d, %d lights, step %g voxels: depends on the camera, runs every frame", o->width, o->height, n,
-        o->step_voxels);
+    const veil_multiple* ms = &s->multiple;
+    why(rep, "%dx%d, %d lights, step %g voxels%s: depends on the camera, runs every frame", o->width, o->height, n,
+        o->step_voxels, ms->volumetric && ms->octaves > 1 ? ", volumetric multiple scattering (octaves)" : "");
+    if (res == VEIL_OK) res = spread(r, s, o, images, st, err);
     return res;
 }
 

@@ -54,6 +54,13 @@ typedef struct veil_render_opts {
      * so alpha (1 - mean T) is the transmittance of a prefix of the same
      * march (tests of T along rays). 0: no limit. */
     float max_distance;
+    /* A frame rendered elsewhere (veil fog): width*height RGBA radiance of
+     * the surfaces behind the medium (replacing the scene's background;
+     * the screen-space spread blurs it) and, per pixel, their distance
+     * along the camera ray (m, >= 0, +inf: nothing there), where each ray
+     * ends. NULL: the scene's background at infinity. */
+    const float* behind;
+    const float* behind_distance;
 } veil_render_opts;
 
 /* opts (NULL: all defaults) with every zero replaced by what it means for

@@ -4,6 +4,7 @@
  * are read in io/scene_sources.c. */
 #include "scene.h"
 #include "json_read.h"
+#include "scene_multiple.h"
 #include "scene_sources.h"
 
 #include <cJSON.h>
@@ -18,7 +19,7 @@
 
 #define SCENE_MAX_FILE_BYTES ((size_t)256 << 20) /* 256 MiB */
 
-static const char* const ROOT_KEYS[] = {"camera", "medium", "lights", "background", NULL};
+static const char* const ROOT_KEYS[] = {"camera", "medium", "lights", "background", "multiple_scattering", NULL};
 static const char* const CAMERA_KEYS[] = {"position", "look_at", "up", "fov_y_deg", "width", "height", NULL};
 static const char* const MEDIUM_KEYS[] = {"sigma_a", "sigma_s", "phase", "max_resolution", "sources", NULL};
 static const char* const PHASE_TYPES[] = {"isotropic", "hg", NULL}; /* = veil_phase_type */
@@ -169,6 +170,7 @@ static veil_result parse_root(const ctx* c, const cJSON* root, veil_scene* s)
     TRY(parse_camera(c, root, &s->camera));
     TRY(parse_medium(c, root, &s->medium));
     TRY(parse_lights(c, root, s));
+    TRY(veil__parse_multiple(c, root, &s->multiple));
     return parse_background(c, root, s->background);
 }
 

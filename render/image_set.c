@@ -6,7 +6,9 @@
 #include "../io/image.h"
 
 const char* const veil_image_set_channel_names[VEIL_IMAGE_SET_CHANNELS] = {
-    "R", "G", "B", "A", "T.R", "T.G", "T.B", "P", "single.R", "single.G", "single.B", "depth"};
+    "R", "G", "B", "A", "T.R", "T.G", "T.B", "P", "single.R", "single.G", "single.B", "depth",
+    "multiple.volume.R", "multiple.volume.G", "multiple.volume.B",
+    "multiple.screen.R", "multiple.screen.G", "multiple.screen.B"};
 
 void veil_image_set_free(veil_image_set* s)
 {
@@ -14,14 +16,28 @@ void veil_image_set_free(veil_image_set* s)
     free(s->rgba);
     free(s->aov_t);
     free(s->aov_s);
+    free(s->aov_v);
+    free(s->aov_m);
+    free(s->aov_q);
     memset(s, 0, sizeof *s);
 }
 
 void veil_image_set_plane(const veil_image_set* s, int c, float* out)
 {
-    const float* src = c < 4 ? s->rgba : c < 8 ? s->aov_t : s->aov_s;
-    size_t n = (size_t)s->width * (size_t)s->height;
-    for (size_t i = 0; i < n; ++i) out[i] = src[4 * i + (size_t)(c % 4)];
+    const float* src;
+    size_t n = (size_t)s->width * (size_t)s->height, k;
+    if (c < 12) {
+        src = c < 4 ? s->rgba : c < 8 ? s->aov_t : s->aov_s;
+        k = (size_t)(c % 4);
+    } else {
+        src = c < 15 ? s->aov_v : s->aov_m;
+        k = (size_t)((c - 12) % 3);
+    }
+    if (!src) {
+        memset(out, 0, n * sizeof *out);
+        return;
+    }
+    for (size_t i = 0; i < n; ++i) out[i] = src[4 * i + k];
 }
 
 veil_result veil_image_set_write_exr(const veil_image_set* s, const char* path, int aovs, veil_error* err)

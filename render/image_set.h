@@ -12,7 +12,14 @@
  *   aov_s  single scattering (R, G, B: the medium's own light, background
  *          excluded) and depth, the mean distance (m) of the ray's first
  *          interaction, 0 where the ray meets no medium
- * Multiple scattering will add its own part here.
+ *   aov_v  volumetric multiple scattering (R, G, B: the octave estimate;
+ *          0 when it is off); A unused
+ *   aov_m  screen-space multiple scattering (R, G, B: the spread light;
+ *          0 when the pass is off or skipped); A: the MIP level read
+ *   aov_q  (not written to files) the screen-space pass's source: single
+ *          scattering's light scattered, not absorbed, on its way to the
+ *          camera (R, G, B), and the luminance-weighted P of it
+ * rgba = T * background + single + volumetric + screen-space.
  */
 #ifndef VEIL_IMAGE_SET_H
 #define VEIL_IMAGE_SET_H
@@ -24,13 +31,18 @@ typedef struct veil_image_set {
     float* rgba;
     float* aov_t;
     float* aov_s;
+    float* aov_v;
+    float* aov_m;
+    float* aov_q;
 } veil_image_set;
 
 void veil_image_set_free(veil_image_set* s); /* accepts NULL and zeroed sets */
 
 /* The EXR channels an image set can hold, by name: "R", "G", "B", "A",
- * "T.R", "T.G", "T.B", "P", "single.R", "single.G", "single.B", "depth". */
-#define VEIL_IMAGE_SET_CHANNELS 12
+ * "T.R", "T.G", "T.B", "P", "single.R", "single.G", "single.B", "depth",
+ * "multiple.volume.R", ".G", ".B", "multiple.screen.R", ".G", ".B"
+ * (a zero plane when its buffer is NULL). */
+#define VEIL_IMAGE_SET_CHANNELS 18
 extern const char* const veil_image_set_channel_names[VEIL_IMAGE_SET_CHANNELS];
 
 /* The plane of channel c (an index into the names above) into out

@@ -61,7 +61,7 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
     set3(u->cam_up, cam.up, 0.0f);
     for (int c = 0; c < 3; ++c) u->sigma_t[c] = m->sigma_a[c] + m->sigma_s[c];
     set3(u->sigma_s, m->sigma_s, 0.0f);
-    set3(u->background, d->scene->background, 0.0f);
+    if (!d->no_background) set3(u->background, d->scene->background, 0.0f);
     float g = m->phase.type == VEIL_PHASE_HG ? m->phase.g : 0.0f;
     if (d->grid) {
         float lo[3], hi[3], inv[3];
@@ -98,6 +98,12 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
     u->flags[0] = d->grid != NULL;
     u->flags[1] = d->grid != NULL && fogs == 0 && d->skip_empty;
     u->flags[2] = d->seed;
+    u->flags[3] = d->end_distance != NULL;
+    const veil_multiple* ms = &d->scene->multiple;
+    if (ms->volumetric && ms->octaves > 1) {
+        u->octave[0] = ms->octave_a, u->octave[1] = ms->octave_b, u->octave[2] = ms->octave_c;
+        u->octave[3] = (float)ms->octaves;
+    }
     return VEIL_OK;
 }
 
@@ -118,12 +124,23 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
     int w = d->width, h = d->height;
     size_t floats;
     if (!veil_mul_sizes((size_t)w, (size_t)h, 4, 1, &floats)) return veil_fail(err, VEIL_ERR_LIMIT, "image too large");
-    GLuint tex[3] = {0};
-    static const char* const labels[3] = {"veil image", "veil image T, P", "veil image single, depth"};
-    static const GLuint units[3] = {VEIL_IMAGE_OUT, VEIL_IMAGE_AOV_T, VEIL_IMAGE_AOV_S};
-    for (int i = 0; i < 3 && r == VEIL_OK; ++i) r = image(w, h, labels[i], &tex[i], err);
-    float** dst[3] = {&out->rgba, &out->aov_t, &out->aov_s};
-    for (int i = 0; i < 3 && r == VEIL_OK; ++i) {
+    enum { N = 5 };
+    GLuint tex[N] = {0};
+    static const char* const labels[N] = {"veil image", "veil image T, P", "veil image single, depth",
+                                          "veil image volumetric", "veil image out-scattered single"};
+    static const GLuint units[N] = {VEIL_IMAGE_OUT, VEIL_IMAGE_AOV_T, VEIL_IMAGE_AOV_S, VEIL_IMAGE_AOV_V,
+                                    VEIL_IMAGE_AOV_Q};
+    for (int i = 0; i < N && r == VEIL_OK; ++i) r = image(w, h, labels[i], &tex[i], err);
+    GLuint limit = 0;
+    if (r == VEIL_OK && d->end_distance) {
+        glCreateTextures(GL_TEXTURE_2D, 1, &limit);
+        glTextureStorage2D(limit, 1, GL_R32F, w, h);
+        glTextureSubImage2D(limit, 0, 0, 0, w, h, GL_RED, GL_FLOAT, d->end_distance);
+        glObjectLabel(GL_TEXTURE, limit, -1, "veil ray ends");
+        r = veil_gl_check("veil ray ends", err);
+    }
+    float** dst[N] = {&out->rgba, &out->aov_t, &out->aov_s, &out->aov_v, &out->aov_q};
+    for (int i = 0; i < N && r == VEIL_OK; ++i) {
         *dst[i] = malloc(floats * sizeof(float));
         if (!*dst[i]) r = veil_fail(err, VEIL_ERR_OOM, "out of memory for a %dx%d image", w, h);
     }
@@ -135,18 +152,20 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         glBindTextureUnit(VEIL_TEX_EV, d->grid ? d->ev : 0);
         glBindTextureUnit(VEIL_TEX_OCC, d->grid ? d->occupancy : 0);
         for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, d->opv ? d->opv[t] : 0);
-        for (int i = 0; i < 3; ++i) glBindImageTexture(units[i], tex[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        glBindTextureUnit(VEIL_TEX_LIMIT, limit);
+        for (int i = 0; i < N; ++i) glBindImageTexture(units[i], tex[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glDispatchCompute(veil_groups(w, VEIL_MARCH_GROUP), veil_groups(h, VEIL_MARCH_GROUP), 1);
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
-        for (int i = 0; i < 3; ++i) glBindImageTexture(units[i], 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        for (int t = 0; t <= VEIL_TEX_OCC; ++t) glBindTextureUnit((GLuint)t, 0);
+        for (int i = 0; i < N; ++i) glBindImageTexture(units[i], 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        for (int t = 0; t <= VEIL_TEX_LIMIT; ++t) glBindTextureUnit((GLuint)t, 0);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, 0);
         glUseProgram(0);
         r = veil_gl_check("ray march (render/shaders/march.comp)", err);
-        for (int i = 0; i < 3 && r == VEIL_OK; ++i)
+        for (int i = 0; i < N && r == VEIL_OK; ++i)
             r = veil_gl_read_texture(tex[i], GL_RGBA, floats, *dst[i], "reading back the image", err);
     }
-    glDeleteTextures(3, tex);
+    glDeleteTextures(N, tex);
+    glDeleteTextures(1, &limit);
     if (r != VEIL_OK) veil_image_set_free(out);
     return r;
 }

@@ -44,6 +44,9 @@ typedef struct veil_march_desc {
     uint32_t seed;             /* jitter seed */
     int skip_empty;            /* 1: jump over bricks without density (when there is no fog) */
     float max_distance;        /* > 0: no step starts at or beyond it (m); 0: no limit */
+    const float* end_distance; /* NULL, or width*height distances (m, >= 0, +inf allowed) along each
+                                  pixel's ray where it ends (a surface behind the medium) */
+    int no_background;         /* 1: add no background (the caller composes what is behind) */
 } veil_march_desc;
 
 veil_result veil_march_create(veil_march** out, veil_error* err);

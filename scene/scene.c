@@ -56,3 +56,55 @@ veil_result veil_scene_particles(const veil_scene* s, veil_particle** out,
     *out = p, *count = total;
     return VEIL_OK;
 }
+
+/* ---- multiple scattering settings -------------------------------------- */
+
+int veil_spread_taps(veil_spread_filter f) { return f == VEIL_SPREAD_2X2 ? 2 : (f == VEIL_SPREAD_6X6 ? 6 : 4); }
+
+void veil_spread_default_weights(veil_spread_filter f, float w[6])
+{
+    memset(w, 0, 6 * sizeof *w);
+    if (f == VEIL_SPREAD_2X2) {
+        w[0] = w[1] = 0.5f; /* a box: the plain MIP average */
+    } else if (f == VEIL_SPREAD_4X4) {
+        /* the paper's taps (Elek et al. 2013) */
+        w[0] = w[3] = 0.13f;
+        w[1] = w[2] = 0.37f;
+    } else {
+        /* a unit-variance Gaussian sampled at +-0.5, +-1.5, +-2.5 pixels,
+         * normalised: exp(-x^2/2) = 0.8825, 0.3247, 0.0439 over 2.5022 */
+        w[0] = w[5] = 0.0175f;
+        w[1] = w[4] = 0.1298f;
+        w[2] = w[3] = 0.3527f;
+    }
+}
+
+void veil_multiple_defaults(veil_multiple* m)
+{
+    memset(m, 0, sizeof *m);
+    m->screen_space = 1;
+    m->volumetric = 1;
+    m->c = 0.86f;
+    m->mask_epsilon = 2.0f;
+    m->mask = 1;
+    m->luminance_weighting = 1;
+    m->density_blur = 1;
+    m->levels = 0;
+    m->filter = VEIL_SPREAD_4X4;
+    veil_spread_default_weights(m->filter, m->weights);
+    m->interp = VEIL_INTERP_LINEAR_BICUBIC;
+    m->separation = 0;
+    /* the paper states no values for these: a pixel counts as bright from
+     * 10x the luminance of a white surface lit at 1 W/m^2 (1/pi), and as
+     * clear when its integrated density is below 1 density-metre */
+    m->sep_luminance = 3.0f;
+    m->sep_luminance_width = 3.0f;
+    m->sep_density = 1.0f;
+    m->sep_density_width = 0.5f;
+    m->k_ssc = 0.7f;
+    m->thin_threshold = 1e-3f;
+    m->octaves = 4;
+    m->octave_a = 0.5f;
+    m->octave_b = 0.5f;
+    m->octave_c = 0.5f;
+}

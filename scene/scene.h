@@ -108,6 +108,54 @@ typedef struct veil_light {
     float inner_angle_deg, outer_angle_deg;
 } veil_light;
 
+/* Multiple scattering ("multiple_scattering" in a scene file; see
+ * docs/multiple-scattering.md for the derivation and the measurements that
+ * chose the defaults). Two estimates, each switched on or off:
+ *  - screen-space: the hierarchical spread of Iser & Elek (CESCG 2018, after
+ *    Elek et al. 2013): the light scattered out of each pixel's beam (of the
+ *    background, and of the single scattering on its way to the camera) is
+ *    spread with Premoze's Gaussian width W(P), through MIP chains;
+ *  - volumetric: the octave approximation (Wrenninge et al. 2013): each
+ *    light's in-scattering is repeated with the optical depth scaled by a^i,
+ *    the contribution by b^i and the phase function's g by c^i. */
+typedef enum veil_spread_filter { VEIL_SPREAD_2X2 = 0, VEIL_SPREAD_4X4 = 1, VEIL_SPREAD_6X6 = 2 } veil_spread_filter;
+/* VEIL_INTERP_* (core/shared.glsl.h: the fetch shader reads the same values) */
+typedef int veil_spread_interp;
+
+typedef struct veil_multiple {
+    int screen_space;     /* 1: the screen-space spread */
+    int volumetric;       /* 1: the octave estimate in the march */
+    /* screen-space */
+    float c;              /* pixels: a level-k texel spreads by about c 2^(k-1) (paper: 0.86) */
+    float mask_epsilon;   /* unitless: width of the leak mask, smoothstep(T, (1+eps) T, W) (paper: 2) */
+    int mask;             /* 1: mask illumination leaking (paper) */
+    int luminance_weighting; /* 1: the spread-space chain W is luminance-weighted (paper) */
+    int density_blur;     /* 1: the level is read through the blurred density chain P (paper) */
+    int levels;           /* K, the coarsest level; 0: from the image size (see render/spread.h) */
+    veil_spread_filter filter;
+    float weights[6];     /* the 1D filter taps (filter 2, 4 or 6 of them), normalised to sum 1 */
+    veil_spread_interp interp;
+    int separation;       /* 1: bright pixels get their own chain (paper: optional) */
+    float sep_luminance;  /* T_y: luminance (linear RGB radiance) above which a pixel is bright */
+    float sep_luminance_width; /* eps_y: same unit */
+    float sep_density;    /* T_d': integrated density (density m) below which it may be separated */
+    float sep_density_width;   /* eps_d': same unit */
+    float k_ssc;          /* the separated chain's level as a fraction of K (paper: 0.7) */
+    float thin_threshold; /* unitless: the spread is skipped where max P * sigma_s (mean) is below it */
+    /* volumetric (octave) */
+    int octaves;          /* N >= 1: octaves 1..N-1 are added (octave 0 is single scattering) */
+    float octave_a;       /* extinction scale per octave, (0, 1] */
+    float octave_b;       /* contribution scale per octave, [0, 1) */
+    float octave_c;       /* phase g scale per octave, [0, 1] */
+} veil_multiple;
+
+/* The defaults: every field as documented in docs/scene-format.md. */
+void veil_multiple_defaults(veil_multiple* m);
+/* The default taps of each filter size (2, 4 or 6 values). */
+void veil_spread_default_weights(veil_spread_filter f, float w[6]);
+/* Taps of filter f: 2, 4 or 6. */
+int veil_spread_taps(veil_spread_filter f);
+
 typedef struct veil_scene {
     char* path;     /* the file as given (owned) */
     char* base_dir; /* its folder, for relative paths (owned) */
@@ -116,6 +164,7 @@ typedef struct veil_scene {
     veil_light* lights; /* owned */
     size_t light_count;
     float background[3]; /* linear RGB radiance seen through the medium */
+    veil_multiple multiple;
 } veil_scene;
 
 void veil_scene_free(veil_scene* s); /* accepts NULL and zeroed scenes */

@@ -7,3 +7,6 @@ add_test(NAME check_layout COMMAND bash ${PROJECT_SOURCE_DIR}/scripts/check-layo
 add_test(NAME check_layout_selftest
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/check_layout_selftest.sh ${PROJECT_SOURCE_DIR}/scripts/check-layout.sh)
 set_tests_properties(check_layout check_layout_selftest PROPERTIES LABELS unit)
+# Premoze's spread width W (limits, Eq. 1), the level selection and the
+# gathering filter against a direct convolution (render/spread.h's CPU parts).
+veil_test(test_spread_width SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_spread_width.c LABELS unit)

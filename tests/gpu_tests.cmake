@@ -24,3 +24,15 @@ veil_test(test_image_set SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_image_set.c LA
 add_test(NAME cli_explain
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli_explain.sh $<TARGET_FILE:veil_cli> ${PROJECT_SOURCE_DIR}/data/scenes)
 set_tests_properties(cli_explain PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)
+# The screen-space spread (render/spread.h): a pure blur keeps energy, the
+# MIP chains against the gathering filter, P = 0 spreads nothing.
+veil_test(test_spread SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_spread.c LABELS "gpu;accuracy")
+# veil fog's path: a frame behind homogeneous fog against closed forms.
+veil_test(test_fog SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_fog.c LABELS "gpu;accuracy")
+# veil fog end to end: good frames, and bad ones (no depth, NaN depth, size) refused.
+add_executable(make_fog_frames ${CMAKE_CURRENT_SOURCE_DIR}/make_fog_frames.c)
+target_link_libraries(make_fog_frames PRIVATE veil veil_fp veil_warnings)
+add_test(NAME fog_cli
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/fog_cli.sh $<TARGET_FILE:veil_cli> $<TARGET_FILE:make_fog_frames>
+          $<TARGET_FILE:exr_stats>)
+set_tests_properties(fog_cli PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)

@@ -133,7 +133,7 @@ static void render_and_read(veil_context* ctx, const veil_scene* scene)
     free(plane);
 
     int n = veil_image_stage_count(img);
-    CHECK(n == 3, "%d stages", n);
+    CHECK(n == 4, "%d stages", n);
     for (int i = 0; i < n; ++i) {
         const char *name = NULL, *status = NULL, *why = NULL;
         double ms = -1.0;

@@ -76,7 +76,7 @@ static double air_g(const air* a, double t)
 
 static void test_airlight_gpu(void)
 {
-    veil_scene s = test_parse_scene(
+    veil_scene s = test_parse_scene_single(
         "{\"camera\":{\"position\":[0,0,0],\"look_at\":[2,0.5,0],\"width\":1,\"height\":1},"
         "\"medium\":{\"sigma_a\":[0.1,0.05,0.0],\"sigma_s\":[0.2,0.3,0.4],\"sources\":[{\"type\":\"exponential\","
         "\"density\":1,\"falloff\":0,\"direction\":[0,1,0],\"origin\":[0,0,0],\"bounds\":[[-20,-20,-20],[20,20,20]]}]},"
@@ -131,7 +131,7 @@ static void test_gaussian_gpu(double cam_z, float step_voxels)
         "\"medium\":{\"sigma_a\":[0.3,0.3,0.3],\"sigma_s\":[0.4,0.7,1.0],\"max_resolution\":64,\"sources\":[{\"type\":"
         "\"rbf\",\"particles\":[{\"center\":[0,0,0],\"amplitude\":2.0,\"sharpness\":3.0}]}]},"
         "\"lights\":[],\"background\":{\"color\":[1,1,1]}}", cam_z);
-    veil_scene s = test_parse_scene(json);
+    veil_scene s = test_parse_scene_single(json);
     veil_scene_volume v;
     veil_error err = {0};
     float* rho = NULL;
@@ -185,7 +185,7 @@ static void test_gaussian_gpu(double cam_z, float step_voxels)
 
 static void test_fog_slant_gpu(void)
 {
-    veil_scene s = test_parse_scene(
+    veil_scene s = test_parse_scene_single(
         "{\"camera\":{\"position\":[-4,2.5,0.3],\"look_at\":[4,-0.5,-0.2],\"width\":1,\"height\":1},"
         "\"medium\":{\"sigma_a\":[0.2,0.0,0.4],\"sigma_s\":[0.6,0.9,0.3],\"sources\":[{\"type\":\"exponential\","
         "\"density\":0.8,\"falloff\":1.5,\"direction\":[0,1,0],\"origin\":[0,0,0],\"bounds\":[[-5,-1,-5],[5,3,5]]}]},"

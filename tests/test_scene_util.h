@@ -22,6 +22,16 @@ static inline veil_scene test_parse_scene(const char* json)
     return s;
 }
 
+/* The same with multiple scattering off: the scene as the single-scattering
+ * march sees it (the closed forms of single scattering and transmittance). */
+static inline veil_scene test_parse_scene_single(const char* json)
+{
+    veil_scene s = test_parse_scene(json);
+    s.multiple.screen_space = 0;
+    s.multiple.volumetric = 0;
+    return s;
+}
+
 /* The ray of a 1x1 image as the renderers form it (float camera, then
  * promoted), so that closed forms see exactly its inputs. */
 static inline void test_camera_ray(const veil_scene* s, double o[3], double d[3])

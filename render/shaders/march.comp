@@ -20,16 +20,32 @@
 // Empty space: where a brick of the EV and the voxel ring around it hold no
 // density (volume/shaders/occupancy.comp) every sample in it would add
 // nothing, so without fog the march jumps to where the ray leaves the brick.
-// Output: rgb = L + T * background, a = 1 - mean(T). With u.limits.x the
-// march ends at the first step boundary at or beyond it (the same steps).
+// Volumetric multiple scattering (u.octave.w = N > 1 octaves): the octave
+// approximation (Wrenninge et al. 2013): beside each light's single
+// in-scattering E exp(-sigma_t D) p(g), the octaves i = 1..N-1 add
+// (b albedo)^i E exp(-a^i sigma_t D) p(c^i g): light that scattered more
+// often reaches deeper (a < 1), is weaker (b < 1, and each scattering keeps
+// the albedo sigma_s / sigma_t of it) and less peaked (c < 1).
+// The screen-space pass's source (aov_q): the part of each step's single
+// scattering that is scattered, not absorbed, on its way to the camera,
+// J (exp(-sigma_a P) - exp(-sigma_t P)) with J the step's light before
+// attenuation and P the density integral from the camera to the step; its
+// alpha is the luminance-weighted mean of that P.
+// Output: rgb = L + L_v + T * background, a = 1 - mean(T). With u.limits.x
+// the march ends at the first step boundary at or beyond it (the same steps);
+// with u.flags.w each pixel's ray ends exactly at the distance in u_limit (a
+// surface of a frame rendered elsewhere: `veil fog`).
 layout(local_size_x = VEIL_MARCH_GROUP, local_size_y = VEIL_MARCH_GROUP) in;
 
 layout(binding = VEIL_IMAGE_OUT, rgba32f) writeonly uniform image2D u_out;     // rgb radiance, a = 1 - mean T
 layout(binding = VEIL_IMAGE_AOV_T, rgba32f) writeonly uniform image2D u_aov_t; // rgb T, a = P (density m)
 layout(binding = VEIL_IMAGE_AOV_S, rgba32f) writeonly uniform image2D u_aov_s; // rgb single scattering, a = depth (m)
+layout(binding = VEIL_IMAGE_AOV_V, rgba32f) writeonly uniform image2D u_aov_v; // rgb volumetric multiple scattering
+layout(binding = VEIL_IMAGE_AOV_Q, rgba32f) writeonly uniform image2D u_aov_q; // rgb out-scattered single, a = its P
 layout(binding = VEIL_TEX_EV) uniform sampler3D u_ev;
 layout(binding = VEIL_TEX_OPV0) uniform sampler3D u_opv[VEIL_MAX_OPV_TEXTURES];
 layout(binding = VEIL_TEX_OCC) uniform sampler3D u_occ; // max density per VEIL_BRICK^3 brick (ring included)
+layout(binding = VEIL_TEX_LIMIT) uniform sampler2D u_limit; // u.flags.w: distance (m) where each pixel's ray ends
 layout(std140, binding = VEIL_UBO_MARCH) uniform veil_march_ubo { veil_march_block u; };
 
 const float INF = 3.0e38;
@@ -78,9 +94,15 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
     return texture(u_opv[l / 4], (y - u.tex_min.xyz) * u.tex_inv_size.xyz)[l % 4];
 }
 
-vec3 in_scattered(vec3 x, vec3 dir)
+// Light scattered towards -dir at x: single scattering returned, the
+// octaves' estimate of the higher orders in `multi`.
+vec3 in_scattered(vec3 x, vec3 dir, out vec3 multi)
 {
     vec3 sum = vec3(0.0);
+    multi = vec3(0.0);
+    int octaves = int(u.octave.w);
+    // each further scattering keeps the single-scattering albedo of the light
+    vec3 albedo = u.sigma_s.rgb / max(u.sigma_t.rgb, vec3(1e-30));
     for (int l = 0; l < u.size.z; ++l) {
         vec3 travel, E;
         float len;
@@ -103,6 +125,13 @@ vec3 in_scattered(vec3 x, vec3 dir)
         float D = min(ev_depth(l, x, -travel, len) + fog_integral(x, -travel, 0.0, len), INF);
         float cos_theta = clamp(dot(travel, -dir), -1.0, 1.0);
         sum += E * exp(-u.sigma_t.rgb * D) * veil_phase_hg(cos_theta, u.march.w);
+        float a = 1.0, g = u.march.w;
+        vec3 b = vec3(1.0);
+        for (int i = 1; i < octaves; ++i) {
+            a *= u.octave.x, g *= u.octave.z;
+            b *= u.octave.y * albedo;
+            multi += b * E * exp(-(a * u.sigma_t.rgb) * D) * veil_phase_hg(cos_theta, g);
+        }
     }
     return sum;
 }
@@ -123,7 +152,8 @@ void main()
     vec2 s = vec2(2.0 * (float(p.x) + 0.5) / float(u.size.xy.x) - 1.0,
                   1.0 - 2.0 * (float(p.y) + 0.5) / float(u.size.xy.y));
     vec3 dir = normalize(u.cam_fwd.xyz + s.x * u.cam_right.xyz + s.y * u.cam_up.xyz);
-    vec3 T = vec3(1.0), L = vec3(0.0);
+    vec3 T = vec3(1.0), L = vec3(0.0), Lv = vec3(0.0), Q = vec3(0.0);
+    float q_p = 0.0, q_w = 0.0;        // luminance-weighted P of Q
     float P = 0.0;                     // density integral along the ray (density m)
     float depth_sum = 0.0, depth_w = 0.0; // extinction-weighted distance
 
@@ -137,6 +167,8 @@ void main()
             t_end = max(t_end, fs.y);
         }
     }
+    // a surface behind the medium (veil fog): the ray ends there, exactly
+    if (u.flags.w != 0u) t_end = min(t_end, texelFetch(u_limit, p, 0).r);
     uint h = hash32(uint(p.x) + hash32(uint(p.y) + hash32(u.flags.z)));
     float jitter = (float(h >> 8) + 1.0) * (1.0 / 16777216.0); // (0, 1]
     float t = t_begin;
@@ -171,8 +203,18 @@ void main()
             // sigma_s (rho_dt frac) = sigma_s (1 - exp(-opt)) / sigma_t <= 1: in this order (precise:
             // not reassociated) nothing overflows; rho_dt * L_in first can (dense fog near a light),
             // and 0 * inf in a channel without scattering is NaN
-            precise vec3 w = T * (u.sigma_s.rgb * (rho_dt * frac));
-            L += w * in_scattered(x, dir);
+            precise vec3 j = u.sigma_s.rgb * (rho_dt * frac);
+            precise vec3 w = T * j;
+            vec3 multi;
+            vec3 single = in_scattered(x, dir, multi);
+            L += w * single;
+            Lv += w * multi;
+            float p_mid = P + 0.5 * rho_dt;
+            vec3 q = j * single * max(exp(-(u.sigma_t.rgb - u.sigma_s.rgb) * p_mid) - exp(-u.sigma_t.rgb * p_mid), 0.0);
+            float yq = dot(q, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B));
+            Q += q;
+            q_p += yq * p_mid;
+            q_w += yq;
             vec3 T_next = T * exp(-opt);
             float absorbed = dot(T - T_next, vec3(1.0 / 3.0)); // chance the first interaction is in this step
             depth_sum += absorbed * 0.5 * (t + te);
@@ -183,7 +225,9 @@ void main()
         }
         t = te;
     }
-    imageStore(u_out, p, vec4(L + T * u.background.rgb, 1.0 - (T.r + T.g + T.b) / 3.0));
+    imageStore(u_out, p, vec4(L + Lv + T * u.background.rgb, 1.0 - (T.r + T.g + T.b) / 3.0));
+    imageStore(u_aov_v, p, vec4(Lv, 0.0));
+    imageStore(u_aov_q, p, vec4(Q, q_w > 0.0 ? min(q_p / q_w, INF) : 0.0));
     imageStore(u_aov_t, p, vec4(T, min(P, INF)));
     imageStore(u_aov_s, p, vec4(L, depth_w > 0.0 ? depth_sum / depth_w : 0.0));
 }

@@ -1,0 +1,172 @@
+/* veil fog FRAME.exr --scene fog.json -o OUT.exr [--png OUT.png]
+ *                  [--depth-channel NAME] [--depth-is z|distance] [--aovs] [--stats]
+ *
+ * Adds the scene's medium to a frame rendered elsewhere with the scene's
+ * camera (the paper's own use case: Iser & Elek 2018): the surfaces in
+ * FRAME are attenuated by the medium in front of them, the medium's single
+ * scattering (and the volumetric estimate) is added in front of them, and
+ * the light they send through the medium is spread (screen-space multiple
+ * scattering: glow and blur). The medium, lights and settings come from the
+ * scene; its background is replaced by the frame.
+ *
+ * FRAME: R, G, B (linear radiance; A is ignored) and a depth channel, the
+ * first of Z, depth.Z, depth, distance that it holds (or --depth-channel).
+ * By default depth is Z, the distance along the camera's view axis (what
+ * Blender, Arnold and most renderers write as Z): each ray's distance is
+ * Z / cos(angle off the axis). --depth-is distance reads it as the
+ * distance along the ray. +inf (sky, nothing hit) is allowed.
+ * Errors (exit 1, nothing written): FRAME missing or not an EXR, no depth
+ * channel, a size other than the scene camera's, a NaN or negative depth,
+ * a non-finite colour.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli_util.h"
+#include "commands.h"
+#include "frame/renderer.h"
+#include "gpu/gl_context.h"
+#include "io/image.h"
+#include "io/scene.h"
+#include "scene/camera.h"
+
+typedef struct fog_args {
+    const char *frame, *scene, *exr, *png, *depth_channel;
+    int depth_is_distance, aovs, stats;
+} fog_args;
+
+static int parse_fog_args(int argc, char** argv, fog_args* a)
+{
+    memset(a, 0, sizeof *a);
+    for (int i = 2; i < argc; ++i) {
+        const char* s = argv[i];
+        const char* v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(s, "--aovs")) { a->aovs = 1; continue; }
+        if (!strcmp(s, "--stats")) { a->stats = 1; continue; }
+        int takes = !strcmp(s, "-o") || !strcmp(s, "--png") || !strcmp(s, "--scene") ||
+                    !strcmp(s, "--depth-channel") || !strcmp(s, "--depth-is");
+        if (takes && !v) return veil_cli_usage_error("%s needs a value", s);
+        if (!strcmp(s, "-o")) a->exr = v;
+        else if (!strcmp(s, "--png")) a->png = v;
+        else if (!strcmp(s, "--scene")) a->scene = v;
+        else if (!strcmp(s, "--depth-channel")) a->depth_channel = v;
+        else if (!strcmp(s, "--depth-is")) {
+            if (!strcmp(v, "z")) a->depth_is_distance = 0;
+            else if (!strcmp(v, "distance")) a->depth_is_distance = 1;
+            else return veil_cli_usage_error("--depth-is: expected z or distance, got '%s'", v);
+        } else if (s[0] == '-' && s[1]) return veil_cli_usage_error("unknown option '%s'", s);
+        else if (!a->frame) { a->frame = s; continue; }
+        else return veil_cli_usage_error("unexpected argument '%s'", s);
+        ++i;
+    }
+    if (!a->frame) return veil_cli_usage_error("%s", "fog: missing FRAME.exr");
+    if (!a->scene) return veil_cli_usage_error("%s", "fog: missing --scene SCENE.json");
+    if (!a->exr) return veil_cli_usage_error("%s", "fog: missing -o OUT.exr");
+    return -1;
+}
+
+/* The frame's depth plane: the named channel, or the first usual one. */
+static veil_result read_depth(const fog_args* a, int w, int h, float** depth, const char** used, veil_error* err)
+{
+    static const char* const usual[] = {"Z", "depth.Z", "depth", "distance", NULL};
+    const char* one[] = {a->depth_channel, NULL};
+    const char* const* names = a->depth_channel ? one : usual;
+    for (int i = 0; names[i]; ++i) {
+        int dw = 0, dh = 0;
+        veil_error e = {0};
+        if (veil_read_exr_channel(a->frame, names[i], &dw, &dh, depth, &e) != VEIL_OK) continue;
+        if (dw != w || dh != h) {
+            free(*depth);
+            *depth = NULL;
+            return veil_fail(err, VEIL_ERR_INVALID, "%s: channel %s is %dx%d, the colour %dx%d", a->frame, names[i],
+                             dw, dh, w, h);
+        }
+        *used = names[i];
+        return VEIL_OK;
+    }
+    if (a->depth_channel)
+        return veil_fail(err, VEIL_ERR_INVALID, "%s: no channel '%s' (--depth-channel)", a->frame, a->depth_channel);
+    return veil_fail(err, VEIL_ERR_INVALID, "%s: no depth channel: expected one of Z, depth.Z, depth, distance "
+                     "(or name it with --depth-channel)", a->frame);
+}
+
+/* Depth -> distance along each pixel's ray; refuses NaN and negative depth. */
+static veil_result to_distance(const fog_args* a, const veil_camera* cam, int w, int h, const char* channel,
+                               float* depth, veil_error* err)
+{
+    veil_camera_basis b;
+    veil_result r = veil_camera_make_basis(cam, w, h, &b, err);
+    if (r != VEIL_OK) return r;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            float* d = &depth[(size_t)y * (size_t)w + (size_t)x];
+            if (isnan(*d) || *d < 0.0f)
+                return veil_fail(err, VEIL_ERR_INVALID, "%s: channel %s at pixel (%d, %d) is %g: expected a depth "
+                                 ">= 0 (m; inf where nothing was hit)", a->frame, channel, x, y, *d);
+            if (a->depth_is_distance) continue;
+            float dir[3];
+            veil_camera_ray(&b, w, h, x, y, dir);
+            float cos_axis = dir[0] * b.fwd[0] + dir[1] * b.fwd[1] + dir[2] * b.fwd[2];
+            *d = *d / cos_axis; /* cos_axis >= cos(diagonal half-angle) > 0; inf stays inf */
+        }
+    return VEIL_OK;
+}
+
+int veil_cmd_fog(int argc, char** argv)
+{
+    fog_args a;
+    int rc = parse_fog_args(argc, argv, &a);
+    if (rc >= 0) return rc;
+    veil_error err = {0};
+    veil_scene scene = {0};
+    float *frame = NULL, *depth = NULL;
+    int w = 0, h = 0;
+    const char* channel = NULL;
+    veil_result r = veil_cli_check_output_folder(a.exr, &err);
+    if (r == VEIL_OK && a.png) r = veil_cli_check_output_folder(a.png, &err);
+    if (r == VEIL_OK) r = veil_scene_load(a.scene, &scene, &err);
+    if (r == VEIL_OK) r = veil_read_exr(a.frame, &w, &h, &frame, &err);
+    if (r == VEIL_OK && (w != scene.camera.width || h != scene.camera.height))
+        r = veil_fail(&err, VEIL_ERR_INVALID, "%s is %dx%d but the scene %s's camera is %dx%d (camera.width, "
+                      "camera.height): the frame must be rendered with the scene's camera", a.frame, w, h, a.scene,
+                      scene.camera.width, scene.camera.height);
+    for (size_t i = 0; r == VEIL_OK && i < (size_t)w * (size_t)h * 4; ++i)
+        if (i % 4 != 3 && !isfinite(frame[i]))
+            r = veil_fail(&err, VEIL_ERR_INVALID, "%s: pixel (%zu, %zu) channel %c is %g: expected finite radiance",
+                          a.frame, (i / 4) % (size_t)w, (i / 4) / (size_t)w, "RGB"[i % 4], frame[i]);
+    if (r == VEIL_OK) r = read_depth(&a, w, h, &depth, &channel, &err);
+    if (r == VEIL_OK) r = to_distance(&a, &scene.camera, w, h, channel, depth, &err);
+    veil_gl* gl = NULL;
+    veil_renderer* ren = NULL;
+    veil_image_set im = {0};
+    veil_render_stats st = {0};
+    if (r == VEIL_OK) r = veil_gl_create(NULL, &gl, &err);
+    if (r == VEIL_OK) r = veil_renderer_create(gl, &ren, &err);
+    if (r == VEIL_OK) {
+        veil_render_opts opts = {.behind = frame, .behind_distance = depth};
+        r = veil_render_scene_images(ren, &scene, &opts, &im, &st, &err);
+        if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
+    }
+    if (r == VEIL_OK) r = veil_image_set_write_exr(&im, a.exr, a.aovs, &err);
+    if (r == VEIL_OK && a.png) {
+        r = veil_write_png(a.png, im.width, im.height, im.rgba, 0.0f, &err);
+        if (r != VEIL_OK) unlink(a.exr); /* all or nothing */
+    }
+    if (r == VEIL_OK && a.stats)
+        for (int i = 0; i < VEIL_STAGE_COUNT; ++i)
+            printf("%-10s %9.2f ms  (%s: %s)\n", veil_stage_name((veil_stage_id)i), st.stage[i].ms,
+                   veil_stage_status_name(st.stage[i].status), st.stage[i].why);
+    if (r == VEIL_OK) printf("wrote %s%s%s (depth from channel %s, as %s)\n", a.exr, a.png ? " and " : "",
+                             a.png ? a.png : "", channel, a.depth_is_distance ? "distance along the ray" : "Z");
+    veil_image_set_free(&im);
+    veil_renderer_destroy(ren);
+    veil_gl_destroy(gl);
+    veil_scene_free(&scene);
+    free(frame);
+    free(depth);
+    return r == VEIL_OK ? EXIT_OK : veil_cli_fail(r, &err);
+}

@@ -1,0 +1,120 @@
+/* veil — the "multiple_scattering" object of a scene file (scene/scene.h's
+ * veil_multiple; docs/scene-format.md lists every field with its unit).
+ * Absent fields keep veil_multiple_defaults(). */
+#include "scene_multiple.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static const char* const MS_KEYS[] = {
+    "screen_space", "volumetric", "c", "mask_epsilon", "mask", "luminance_weighting", "density_blur", "levels",
+    "filter", "weights", "interpolation", "separation", "separation_luminance", "separation_luminance_width",
+    "separation_density", "separation_density_width", "k_ssc", "thin_threshold", "octaves", "octave_extinction",
+    "octave_contribution", "octave_eccentricity", NULL};
+static const char* const FILTERS[] = {"2x2", "4x4", "6x6", NULL};                                 /* = veil_spread_filter */
+static const char* const INTERPS[] = {"linear-bilinear", "linear-bicubic", "cubic-bicubic", NULL}; /* = veil_spread_interp */
+
+static const range R_POS = {0, 1e30, true, false, false, "a number > 0"};
+static const range R_NONNEG = {0, 1e30, false, false, false, "a number >= 0"};
+static const range R_LEVELS = {0, VEIL_SPREAD_MAX_LEVEL, false, false, true, "an integer in [0, 12] (0: from the image size)"};
+static const range R_UNIT_CLOSED = {0, 1, false, false, false, "a number in [0, 1]"};
+static const range R_UNIT_OPEN_LO = {0, 1, true, false, false, "a number in (0, 1]"};
+static const range R_UNIT_OPEN_HI = {0, 1, false, true, false, "a number in [0, 1)"};
+static const range R_OCTAVES = {1, 16, false, false, true, "an integer in [1, 16]"};
+
+static veil_result get_bool(const ctx* c, const cJSON* o, const jpath* pp, const char* key, int* out)
+{
+    const jpath p = {pp, key, 0};
+    const cJSON* v;
+    TRY(veil__jr_lookup(c, o, &p, false, "true or false", &v));
+    if (!v) return VEIL_OK;
+    if (!cJSON_IsBool(v)) return veil__jr_expected(c, &p, "true or false", v);
+    *out = cJSON_IsTrue(v) ? 1 : 0;
+    return VEIL_OK;
+}
+
+static veil_result get_name(const ctx* c, const cJSON* o, const jpath* pp, const char* key,
+                            const char* const* names, int* out)
+{
+    const jpath p = {pp, key, 0};
+    char what[160] = "one of ";
+    veil__jr_join(names, true, what + 7, sizeof what - 7);
+    const cJSON* v;
+    TRY(veil__jr_lookup(c, o, &p, false, what, &v));
+    if (!v) return VEIL_OK;
+    for (int i = 0; cJSON_IsString(v) && names[i]; ++i) {
+        if (strcmp(v->valuestring, names[i]) == 0) {
+            *out = i;
+            return VEIL_OK;
+        }
+    }
+    return veil__jr_expected(c, &p, what, v);
+}
+
+static veil_result get_float(const ctx* c, const cJSON* o, const jpath* pp, const char* key, const range* r,
+                             float* out)
+{
+    double x = *out;
+    TRY(veil__jr_get_number(c, o, pp, key, false, r, &x));
+    *out = (float)x;
+    return VEIL_OK;
+}
+
+/* "weights": the filter's taps, as many as it has, >= 0, symmetric is not
+ * required; normalised to sum 1 (a blur that keeps energy). */
+static veil_result get_weights(const ctx* c, const cJSON* o, const jpath* pp, veil_multiple* m)
+{
+    const jpath p = {pp, "weights", 0};
+    const cJSON* v = cJSON_GetObjectItemCaseSensitive(o, "weights");
+    int n = veil_spread_taps(m->filter);
+    if (!v) return VEIL_OK;
+    float w[6] = {0};
+    TRY(veil__jr_parse_floats(c, v, &p, n, true, w));
+    double sum = 0;
+    for (int i = 0; i < n; ++i) sum += w[i];
+    if (!(sum > 0) || !(sum < 1e30))
+        return veil__jr_fail_at(c, &p, "expected %d weights with a positive finite sum (they are normalised)", n);
+    for (int i = 0; i < 6; ++i) m->weights[i] = i < n ? (float)(w[i] / sum) : 0.0f;
+    return VEIL_OK;
+}
+
+veil_result veil__parse_multiple(const ctx* c, const cJSON* root, veil_multiple* m)
+{
+    veil_multiple_defaults(m);
+    const jpath p = {NULL, "multiple_scattering", 0};
+    const cJSON* o;
+    TRY(veil__jr_get_container(c, root, &p, false, false, &o));
+    if (!o) return VEIL_OK;
+    TRY(veil__jr_check_keys(c, o, &p, MS_KEYS));
+    int filter = (int)m->filter, interp = (int)m->interp;
+    TRY(get_bool(c, o, &p, "screen_space", &m->screen_space));
+    TRY(get_bool(c, o, &p, "volumetric", &m->volumetric));
+    TRY(get_float(c, o, &p, "c", &R_POS, &m->c));
+    TRY(get_float(c, o, &p, "mask_epsilon", &R_NONNEG, &m->mask_epsilon));
+    TRY(get_bool(c, o, &p, "mask", &m->mask));
+    TRY(get_bool(c, o, &p, "luminance_weighting", &m->luminance_weighting));
+    TRY(get_bool(c, o, &p, "density_blur", &m->density_blur));
+    TRY(veil__jr_get_int(c, o, &p, "levels", &R_LEVELS, &m->levels));
+    TRY(get_name(c, o, &p, "filter", FILTERS, &filter));
+    m->filter = (veil_spread_filter)filter;
+    veil_spread_default_weights(m->filter, m->weights);
+    TRY(get_weights(c, o, &p, m));
+    TRY(get_name(c, o, &p, "interpolation", INTERPS, &interp));
+    m->interp = (veil_spread_interp)interp;
+    TRY(get_bool(c, o, &p, "separation", &m->separation));
+    TRY(get_float(c, o, &p, "separation_luminance", &R_NONNEG, &m->sep_luminance));
+    TRY(get_float(c, o, &p, "separation_luminance_width", &R_POS, &m->sep_luminance_width));
+    TRY(get_float(c, o, &p, "separation_density", &R_POS, &m->sep_density));
+    TRY(get_float(c, o, &p, "separation_density_width", &R_POS, &m->sep_density_width));
+    if (m->sep_density_width > m->sep_density) {
+        const jpath wp = {&p, "separation_density_width", 0};
+        return veil__jr_fail_at(c, &wp, "expected at most separation_density (%g): the ramp is [T - eps, T] "
+                                "of a density >= 0, got %g", m->sep_density, m->sep_density_width);
+    }
+    TRY(get_float(c, o, &p, "k_ssc", &R_UNIT_CLOSED, &m->k_ssc));
+    TRY(get_float(c, o, &p, "thin_threshold", &R_NONNEG, &m->thin_threshold));
+    TRY(veil__jr_get_int(c, o, &p, "octaves", &R_OCTAVES, &m->octaves));
+    TRY(get_float(c, o, &p, "octave_extinction", &R_UNIT_OPEN_LO, &m->octave_a));
+    TRY(get_float(c, o, &p, "octave_contribution", &R_UNIT_OPEN_HI, &m->octave_b));
+    return get_float(c, o, &p, "octave_eccentricity", &R_UNIT_CLOSED, &m->octave_c);
+}
