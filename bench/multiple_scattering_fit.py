@@ -58,7 +58,7 @@ def main():
         fitted = [v[0] for v in out.values() if v[2]]
         return sum(fitted) / len(fitted), out
 
-    grid = itertools.product((0.15, 0.3, 0.5), (0.5, 0.7, 0.85, 0.95), (0.3, 0.6), (3, 6, 10))
+    grid = itertools.product((0.15, 0.3, 0.5), (0.6, 0.75, 0.85, 0.95), (0.6,), (3, 6))
     best = None
     for oa, ob, oc, n in grid:
         params = {"screen_space": a.screen_space, "volumetric": True, "octave_extinction": oa,

@@ -144,6 +144,20 @@ veil_result veil_plan_explain(const veil_scene* s, const veil_render_opts* opts,
     /* render */
     put(&t, "render     every frame: runs, %dx%d, step %g voxels, %d light%s%s (depends on the camera)\n", o.width,
         o.height, o.step_voxels, n, n == 1 ? "" : "s", fogs ? ", analytic fog in closed form" : "");
+    const veil_multiple* ms = &s->multiple;
+    if (ms->volumetric && ms->octaves > 1)
+        put(&t, "           multiple scattering: volumetric, %d octaves (a %g, b %g, c %g) in the march\n", ms->octaves,
+            ms->octave_a, ms->octave_b, ms->octave_c);
+    /* the spread (frame/renderer.c): only the light from behind, or single scattering's when the
+     * volumetric estimate is off; whether the view is optically thin is known only after the march */
+    if (!ms->screen_space)
+        put(&t, "spread     skipped: off in the scene (multiple_scattering.screen_space)\n");
+    else if (ms->volumetric && !o.behind)
+        put(&t, "spread     skipped: nothing to spread (the volumetric estimate carries the medium's higher orders; "
+                "the background is a backdrop)\n");
+    else
+        put(&t, "spread     every frame: runs unless the view is optically thin (max P sigma_s < %g), "
+                "depends on the camera\n", ms->thin_threshold);
     veil_scene_volume_close(&v);
     if (t.oom) {
         free(t.s);

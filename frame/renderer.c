@@ -218,6 +218,13 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
 
 /* ---- stage 4: screen-space multiple scattering ------------------------ */
 
+/* What the spread moves (docs/multiple-scattering.md): the light from
+ * behind the medium that it scatters without absorbing (veil fog's frame;
+ * the scene's background is a backdrop that lights nothing, as in the
+ * reference path tracer, so it is not spread), and, when the volumetric
+ * estimate is off, the single scattering's light scattered on its way to
+ * the camera (aov_q). With the volumetric estimate on, the medium's higher
+ * orders are its: spreading aov_q too would count them twice. */
 static veil_result spread(veil_renderer* r, const veil_scene* s, const veil_render_opts* o, veil_image_set* im,
                           veil_render_stats* st, veil_error* err)
 {
@@ -228,7 +235,14 @@ static veil_result spread(veil_renderer* r, const veil_scene* s, const veil_rend
         why(rep, "off in the scene (multiple_scattering.screen_space)");
         return VEIL_OK;
     }
-    float thick = veil_spread_max_scattering(s, im->aov_t, im->aov_q, im->width, im->height);
+    const float* q = m->volumetric ? NULL : im->aov_q;
+    if (!o->behind && !q) {
+        rep->status = VEIL_STAGE_SKIPPED;
+        why(rep, "nothing to spread: the volumetric estimate carries the medium's higher orders and the "
+                 "background is a backdrop (veil fog spreads its frame)");
+        return VEIL_OK;
+    }
+    float thick = veil_spread_max_scattering(s, im->aov_t, q, im->width, im->height);
     if (!(thick >= m->thin_threshold)) {
         rep->status = VEIL_STAGE_SKIPPED;
         why(rep, "optically thin view: max P sigma_s = %.3g < thin_threshold %g", thick, m->thin_threshold);
@@ -237,10 +251,8 @@ static veil_result spread(veil_renderer* r, const veil_scene* s, const veil_rend
     size_t floats = (size_t)im->width * (size_t)im->height * 4;
     im->aov_m = malloc(floats * sizeof(float));
     if (!im->aov_m) return veil_fail(err, VEIL_ERR_OOM, "out of memory for the spread image");
-    veil_spread_input in = {.width = im->width, .height = im->height, .L = o->behind,
-                            .background = {s->background[0], s->background[1], s->background[2]},
-                            .aov_t = im->aov_t, .aov_s = im->aov_s, .aov_q = im->aov_q,
-                            .fov_y_deg = o->camera->fov_y_deg};
+    veil_spread_input in = {.width = im->width, .height = im->height, .L = o->behind, .background = {0, 0, 0},
+                            .aov_t = im->aov_t, .aov_s = im->aov_s, .aov_q = q, .fov_y_deg = o->camera->fov_y_deg};
     veil_spread_report sr = {0};
     veil_result res = veil_spread_run(r->spread, s, &in, im->aov_m, NULL, &sr, err);
     if (res != VEIL_OK) return res;
@@ -248,8 +260,9 @@ static veil_result spread(veil_renderer* r, const veil_scene* s, const veil_rend
         for (int c = 0; c < 3; ++c) im->rgba[i + (size_t)c] += im->aov_m[i + (size_t)c];
     rep->ms = sr.ms;
     rep->status = VEIL_STAGE_RAN;
-    why(rep, "max P sigma_s = %.3g >= %g: %d levels on %dx%d, %s filter: depends on the camera", thick,
-        m->thin_threshold, sr.levels, sr.padded_width, sr.padded_height,
+    why(rep, "max P sigma_s = %.3g >= %g: spreads %s%s%s; %d levels on %dx%d, %s filter: depends on the camera",
+        thick, m->thin_threshold, o->behind ? "the frame behind" : "", o->behind && q ? " and " : "",
+        q ? "single scattering's out-scattered light" : "", sr.levels, sr.padded_width, sr.padded_height,
         m->filter == VEIL_SPREAD_2X2 ? "2x2" : m->filter == VEIL_SPREAD_6X6 ? "6x6" : "4x4");
     return VEIL_OK;
 }

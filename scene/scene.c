@@ -103,8 +103,10 @@ void veil_multiple_defaults(veil_multiple* m)
     m->sep_density_width = 0.5f;
     m->k_ssc = 0.7f;
     m->thin_threshold = 1e-3f;
-    m->octaves = 4;
-    m->octave_a = 0.5f;
-    m->octave_b = 0.5f;
-    m->octave_c = 0.5f;
+    /* fitted on data/scenes fog_lights, demo, cloud, vdb_smoke (bench/multiple_scattering_fit.py;
+     * docs/multiple-scattering.md has the grid, the fit and the check on scenes it never saw) */
+    m->octaves = 3;
+    m->octave_a = 0.3f;
+    m->octave_b = 0.75f;
+    m->octave_c = 0.6f;
 }

@@ -139,7 +139,10 @@ static void render_and_read(veil_context* ctx, const veil_scene* scene)
         double ms = -1.0;
         CHECK(veil_image_stage(img, i, &name, &status, &ms, &why) == VEIL_OK, "stage %d", i);
         CHECK(name && *name && status && why && *why && ms >= 0.0, "stage %d report", i);
-        CHECK(status && strcmp(status, "ran") == 0, "stage %d of a first render: %s", i, status ? status : "?");
+        /* the spread (stage 3) has nothing to do in a volume render with the volumetric estimate on */
+        const char* want = i == 3 ? "skipped" : "ran";
+        CHECK(status && strcmp(status, want) == 0, "stage %d of a first render: %s, expected %s", i,
+              status ? status : "?", want);
         CHECK(veil_image_stage(img, i, NULL, NULL, NULL, NULL) == VEIL_OK, "stage %d, no outputs", i);
     }
     const char* first = NULL;

@@ -96,7 +96,7 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
 
 // Light scattered towards -dir at x: single scattering returned, the
 // octaves' estimate of the higher orders in `multi`.
-vec3 in_scattered(vec3 x, vec3 dir, out vec3 multi)
+vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
 {
     vec3 sum = vec3(0.0);
     multi = vec3(0.0);
@@ -125,8 +125,12 @@ vec3 in_scattered(vec3 x, vec3 dir, out vec3 multi)
         float D = min(ev_depth(l, x, -travel, len) + fog_integral(x, -travel, 0.0, len), INF);
         float cos_theta = clamp(dot(travel, -dir), -1.0, 1.0);
         sum += E * exp(-u.sigma_t.rgb * D) * veil_phase_hg(cos_theta, u.march.w);
+        // the chance that light on the two legs through x (from the light,
+        // to the camera) scattered again: no medium around x, no higher orders
+        // (D + p_cam kept finite: 0 * inf would be NaN where sigma_s = 0)
+        float gate = 1.0 - exp(-dot(u.sigma_s.rgb, vec3(1.0 / 3.0)) * min(D + p_cam, INF));
         float a = 1.0, g = u.march.w;
-        vec3 b = vec3(1.0);
+        vec3 b = vec3(gate);
         for (int i = 1; i < octaves; ++i) {
             a *= u.octave.x, g *= u.octave.z;
             b *= u.octave.y * albedo;
@@ -206,10 +210,10 @@ void main()
             precise vec3 j = u.sigma_s.rgb * (rho_dt * frac);
             precise vec3 w = T * j;
             vec3 multi;
-            vec3 single = in_scattered(x, dir, multi);
+            float p_mid = min(P + 0.5 * rho_dt, INF); // finite, as D: a channel with sigma = 0 gets exp(0)
+            vec3 single = in_scattered(x, dir, p_mid, multi);
             L += w * single;
             Lv += w * multi;
-            float p_mid = P + 0.5 * rho_dt;
             vec3 q = j * single * max(exp(-(u.sigma_t.rgb - u.sigma_s.rgb) * p_mid) - exp(-u.sigma_t.rgb * p_mid), 0.0);
             float yq = dot(q, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B));
             Q += q;
