@@ -1,5 +1,6 @@
 /* veil reference SCENE.json -o REF.exr --spp N [--max-order K] [--width W]
  *                [--height H] [--seed N] [--threads T]
+ *                [--light-sampling distance|mis]
  *
  * Renders the scene with the CPU path tracer (reference/pathtracer.h) and
  * writes an EXR with R, G, B, A and the standard error of each mean
@@ -23,6 +24,7 @@
 typedef struct ref_args {
     const char *scene, *exr;
     long spp, max_order, width, height, seed, threads;
+    int light_sampling; /* veil_pt_light_sampling */
 } ref_args;
 
 static int parse_args(int argc, char** argv, ref_args* a)
@@ -59,6 +61,13 @@ static int parse_args(int argc, char** argv, ref_args* a)
         } else if (!strcmp(s, "--threads")) {
             if (!veil_cli_parse_int(v, 1, 256, &a->threads))
                 return veil_cli_usage_error("--threads: expected an integer in 1..256, got '%s'", v);
+        } else if (!strcmp(s, "--light-sampling")) {
+            if (!strcmp(v, "distance"))
+                a->light_sampling = VEIL_PT_LIGHT_SAMPLING_DISTANCE;
+            else if (!strcmp(v, "mis"))
+                a->light_sampling = VEIL_PT_LIGHT_SAMPLING_MIS;
+            else
+                return veil_cli_usage_error("--light-sampling: expected distance or mis, got '%s'", v);
         } else {
             return veil_cli_usage_error("unknown option '%s'", s);
         }
@@ -136,6 +145,7 @@ int veil_cmd_reference(int argc, char** argv)
     o.max_order = (int)a.max_order;
     o.seed = (uint64_t)a.seed;
     o.threads = (int)a.threads;
+    o.light_sampling = a.light_sampling;
     if (isatty(fileno(stderr))) {
         o.progress = show_progress;
         o.progress_user = &prog;
@@ -170,12 +180,16 @@ int veil_cmd_reference(int argc, char** argv)
                 sum += rgba[4 * i + (size_t)c];
                 sum_se += se[3 * i + (size_t)c];
             }
-        printf("wrote %s (%dx%d, %ld spp, max order %ld%s) in %.2f s\n", a.exr, w, h, a.spp, a.max_order,
-               a.max_order == 0 ? " = unlimited" : "", st.ms / 1000.0);
+        printf("wrote %s (%dx%d, %ld spp, max order %ld%s, %s light sampling) in %.2f s\n", a.exr, w, h, a.spp,
+               a.max_order, a.max_order == 0 ? " = unlimited" : "",
+               st.light_sampling == VEIL_PT_LIGHT_SAMPLING_DISTANCE ? "distance" : "MIS", st.ms / 1000.0);
         printf("  mean standard error / mean value: %.3g\n", sum > 0.0 ? sum_se / sum : 0.0);
         printf("  %llu paths, %llu tentative collisions, %llu cut walks, %llu dropped samples\n",
                (unsigned long long)st.paths, (unsigned long long)st.collisions, (unsigned long long)st.cut_walks,
                (unsigned long long)st.dropped_samples);
+        if (st.unresolved_pixels)
+            printf("  %llu pixels with all samples equal: their standard error is a bound (reference/pathtracer.h)\n",
+                   (unsigned long long)st.unresolved_pixels);
     }
     free(rgba);
     free(se);

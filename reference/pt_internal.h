@@ -59,10 +59,36 @@ void veil__pt_transmittance(const veil_pt_medium* m, const double o[3], const do
                             pt_rng* rng, double T[3], pt_counters* c);
 
 /* Exact transmittance (zero variance) along the same path: the volume's
- * optical depth integrated exactly (reference/optical_depth.h) and the
- * fogs' closed form. */
+ * optical depth veil__pt_grid_depth and the fogs' closed form. */
 void veil__pt_transmittance_exact(const veil_pt_medium* m, const double o[3], const double d[3], double len,
                                   double T[3]);
+
+/* Total density at x (unitless; the extinction there is m->sigma_t times
+ * it, m^-1): the volume's trilinear value plus every fog whose box holds
+ * x, exactly as the walks see it. */
+double veil__pt_density(const veil_pt_medium* m, const double x[3]);
+
+/* The part of the ray o + t d, t >= 0, where a walk can collide: from the
+ * first entry into the volume's box or a fog's box to the last exit (gaps
+ * between boxes included). 0 when it meets none or the medium is empty. */
+int veil__pt_medium_span(const veil_pt_medium* m, const double o[3], const double d[3], double* a, double* b);
+
+/* The density (m^-1) with which veil__pt_free_flight from o along unit d,
+ * started with throughput beta0, returns PT_SCATTER at distance t:
+ *   q_d(t) = sum_c beta0_c sigma_s,c rho(t) T_c(t) / sum_c beta0_c
+ * (pathtracer.h derives it), T exact. Also gives rho(t) and T(t); T is not
+ * computed (left 0) where rho(t) is 0, as q_d is then 0. */
+double veil__pt_scatter_pdf(const veil_pt_medium* m, const double o[3], const double d[3], const double beta0[3],
+                            double t, double* rho, double T[3]);
+
+/* The volume's density integrated along o + t d (d unit), t in [t0, t1]
+ * (density * m): exact to rounding, as veil_ref_segment_optical_depth
+ * (reference/optical_depth.h), but 3-4x faster on the demo's grid, which
+ * the MIS weights, evaluated at every vertex, need: the line is cut where
+ * it crosses a voxel-centre plane (the trilinear field is a cubic between
+ * crossings), and each piece, inside one cell whose 8 values are read
+ * once, is integrated by 2-point Gauss-Legendre (exact for cubics). */
+double veil__pt_grid_depth(const veil_pt_medium* m, const double o[3], const double d[3], double t0, double t1);
 
 /* Slab test of o + t d against [lo, hi] for t in [t0, t1]: 1 and the
  * clipped range when they overlap in a segment of positive length. */

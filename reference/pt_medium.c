@@ -187,6 +187,37 @@ static double fog_log_density(const pt_fog* f, const double x[3])
     return log(f->rho0) - f->falloff * k;
 }
 
+double veil__pt_density(const veil_pt_medium* m, const double x[3])
+{
+    double rho = m->has_grid ? veil_ev_sample(&m->grid, m->rho, x) : 0.0;
+    for (int i = 0; i < m->fog_count; ++i) {
+        const pt_fog* f = &m->fog[i];
+        int inside = 1;
+        for (int k = 0; k < 3; ++k) inside &= x[k] >= f->lo[k] && x[k] <= f->hi[k];
+        if (inside) rho += exp(fog_log_density(f, x));
+    }
+    return rho;
+}
+
+int veil__pt_medium_span(const veil_pt_medium* m, const double o[3], const double d[3], double* a, double* b)
+{
+    double lo = INFINITY, hi = -INFINITY, ta, tb;
+    if (!(m->sigma_max > 0.0)) return 0;
+    if (m->has_grid && veil__pt_box_clip(m->box_lo, m->box_hi, o, d, 0.0, INFINITY, &ta, &tb)) {
+        lo = ta;
+        hi = tb;
+    }
+    for (int i = 0; i < m->fog_count; ++i)
+        if (veil__pt_box_clip(m->fog[i].lo, m->fog[i].hi, o, d, 0.0, INFINITY, &ta, &tb)) {
+            lo = fmin(lo, ta);
+            hi = fmax(hi, tb);
+        }
+    if (!(lo < hi)) return 0;
+    *a = lo;
+    *b = hi;
+    return 1;
+}
+
 /* ---- the volume's majorant walk ----------------------------------------------- */
 
 typedef struct dda {
@@ -428,18 +459,83 @@ void veil__pt_transmittance(const veil_pt_medium* m, const double o[3], const do
     }
 }
 
+/* 2-point Gauss-Legendre on [-1, 1]: nodes +-1/sqrt(3), weights 1; exact
+ * for cubics, which is what the trilinear field is along a line within one
+ * cell (a product of three linear functions). */
+#define GL2_NODE 0.577350269189625764509
+
+double veil__pt_grid_depth(const veil_pt_medium* m, const double o[3], const double d[3], double t0, double t1)
+{
+    double a, b;
+    if (!m->has_grid || !veil__pt_box_clip(m->box_lo, m->box_hi, o, d, t0, t1, &a, &b)) return 0.0;
+    const veil_grid* g = &m->grid;
+    const double h = g->voxel;
+    const size_t nx = (size_t)g->dims[0], nxy = nx * (size_t)g->dims[1];
+    double u0[3], du[3], next[3];
+    int cell[3], step[3];
+    for (int k = 0; k < 3; ++k) {
+        /* index coordinate u = u0 + t du; cell i spans u in [i, i + 1] */
+        u0[k] = (o[k] - (double)g->origin[k]) / h - 0.5;
+        du[k] = d[k] / h;
+        double us = u0[k] + a * du[k];
+        int c = du[k] < 0.0 ? (int)ceil(us) - 1 : (int)floor(us);
+        cell[k] = c < 0 ? 0 : (c > g->dims[k] - 2 ? g->dims[k] - 2 : c);
+        step[k] = du[k] > 0.0 ? 1 : (du[k] < 0.0 ? -1 : 0);
+        next[k] = step[k] == 0 ? INFINITY : ((double)(cell[k] + (step[k] > 0)) - u0[k]) / du[k];
+    }
+    double sum = 0.0, t = a;
+    for (;;) {
+        double tn = fmin(fmin(next[0], next[1]), fmin(next[2], b));
+        if (tn > t) {
+            const float* v = m->rho + (size_t)cell[2] * nxy + (size_t)cell[1] * nx + (size_t)cell[0];
+            double c000 = v[0], c100 = v[1], c010 = v[nx], c110 = v[nx + 1];
+            double c001 = v[nxy], c101 = v[nxy + 1], c011 = v[nxy + nx], c111 = v[nxy + nx + 1];
+            double mid = 0.5 * (t + tn), half = 0.5 * (tn - t), piece = 0.0;
+            for (int q = -1; q <= 1; q += 2) {
+                double tq = mid + q * half * GL2_NODE, f[3];
+                for (int k = 0; k < 3; ++k) {
+                    f[k] = u0[k] + tq * du[k] - (double)cell[k];
+                    f[k] = f[k] < 0.0 ? 0.0 : (f[k] > 1.0 ? 1.0 : f[k]); /* rounding at the faces */
+                }
+                double x00 = c000 + f[0] * (c100 - c000), x10 = c010 + f[0] * (c110 - c010);
+                double x01 = c001 + f[0] * (c101 - c001), x11 = c011 + f[0] * (c111 - c011);
+                double y0 = x00 + f[1] * (x10 - x00), y1 = x01 + f[1] * (x11 - x01);
+                piece += y0 + f[2] * (y1 - y0);
+            }
+            sum += piece * half;
+        }
+        if (tn >= b) break;
+        t = tn;
+        for (int k = 0; k < 3; ++k) {
+            if (next[k] > tn) continue;
+            cell[k] += step[k];
+            if (cell[k] < 0 || cell[k] > g->dims[k] - 2) return sum; /* left the box (rounding near b) */
+            next[k] = ((double)(cell[k] + (step[k] > 0)) - u0[k]) / du[k];
+        }
+    }
+    return sum;
+}
+
 void veil__pt_transmittance_exact(const veil_pt_medium* m, const double o[3], const double d[3], double len,
                                   double T[3])
 {
     T[0] = T[1] = T[2] = 1.0;
-    double D = fog_depth(m, o, d, len), a, b;
-    if (m->has_grid && veil__pt_box_clip(m->box_lo, m->box_hi, o, d, 0.0, len, &a, &b)) {
-        double pa[3], pb[3];
-        for (int k = 0; k < 3; ++k) {
-            pa[k] = o[k] + a * d[k];
-            pb[k] = o[k] + b * d[k];
-        }
-        D += veil_ref_segment_optical_depth(&m->grid, m->rho, pa, pb);
-    }
-    attenuate(m, D, T);
+    attenuate(m, fog_depth(m, o, d, len) + veil__pt_grid_depth(m, o, d, 0.0, len), T);
 }
+
+double veil__pt_scatter_pdf(const veil_pt_medium* m, const double o[3], const double d[3], const double beta0[3],
+                            double t, double* rho_out, double T[3])
+{
+    double x[3] = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]};
+    double rho = veil__pt_density(m, x), num = 0.0, den = 0.0;
+    *rho_out = rho;
+    T[0] = T[1] = T[2] = 0.0;
+    if (!(rho > 0.0)) return 0.0;
+    veil__pt_transmittance_exact(m, o, d, t, T);
+    for (int k = 0; k < 3; ++k) {
+        num += beta0[k] * m->sigma_s[k] * T[k];
+        den += beta0[k];
+    }
+    return den > 0.0 ? rho * num / den : 0.0;
+}
+
