@@ -10,7 +10,8 @@ For each scene (at two optical thicknesses: the file's sigma_a, sigma_s and
 those times --thick) it renders every variant with `veil render --stats`
 (time: the median over --runs of the sum of the stages' wall times, i.e. a
 still frame without process start and file writing; per turntable frame:
-render + spread, the stages a moving camera re-runs), and compares it with
+render + spread, the stages a moving camera re-runs; the volumetric field
+is view-independent and kept), and compares it with
 `veil compare --bin 4 --json`: rel_rmse_excess (relative RMSE of 4x4-pixel
 means with the reference's own noise taken out in quadrature) and
 mean_bias (mean RGB / reference's - 1). --study adds the screen-space
@@ -32,7 +33,11 @@ SHARED = os.path.join(os.path.dirname(ROOT), "shared", "data")
 VARIANTS = [
     ("ss", {"screen_space": False, "volumetric": False}),
     ("ss+screen", {"screen_space": True, "volumetric": False}),
-    ("ss+volumetric", {"screen_space": False, "volumetric": True}),
+    # the first fit: octaves gated by the legs through each point
+    ("ss+octave legs", {"screen_space": False, "volumetric": True, "octave_gate": "legs", "octaves": 3,
+                        "octave_extinction": 0.3, "octave_contribution": 0.75, "octave_eccentricity": 0.6}),
+    ("ss+octave escape", {"screen_space": False, "volumetric": True, "octave_gate": "escape"}),
+    ("ss+diffusion", {"screen_space": False, "volumetric": True, "volumetric_method": "diffusion"}),
     ("default", None),  # the scene's own settings: the defaults
 ]
 STUDY = [("screen %s %s" % (f, i), {"screen_space": True, "volumetric": False, "filter": f, "interpolation": i})
@@ -120,7 +125,7 @@ def stage_ms(stats_text):
     ms = {}
     for line in stats_text.splitlines():
         parts = line.split()
-        if len(parts) >= 3 and parts[2] == "ms" and parts[0] in ("inject", "propagate", "render", "spread"):
+        if len(parts) >= 3 and parts[2] == "ms" and parts[0] in ("inject", "propagate", "volumetric", "render", "spread"):
             ms[parts[0]] = float(parts[1])
     return ms
 

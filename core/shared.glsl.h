@@ -111,6 +111,7 @@
 #define VEIL_TEX_OPV0 1         /* texture units 1..4: sampled OPVs */
 #define VEIL_TEX_OCC 5          /* texture unit: occupancy bricks (max density per brick) */
 #define VEIL_TEX_LIMIT 6        /* texture unit: r32f per-pixel distance where the ray ends (veil fog) */
+#define VEIL_TEX_DIFFUSION 7    /* texture unit: rgba32f multiply scattered fluence (render/diffusion.h) */
 
 /* A light as the GPU sees it: one shape for every shader (std140, 48 bytes).
  * Filled from scene/scene.h's veil_light by veil_gpu_light_from(). */
@@ -147,6 +148,8 @@ VEIL_STRUCT_BEGIN(veil_march_block)
     VEIL_IV4(size);        /* x, y: image size (pixels); z: lights; w: fogs */
     VEIL_UV4(flags);       /* x: has a volume, y: skip empty bricks, z: jitter seed, w: per-pixel end */
     VEIL_V4(octave);       /* volumetric multiple scattering: x: a, y: b, z: c, w: octaves (0: off) */
+    VEIL_V4(diffusion);    /* xyz: the volumetric field's texture origin (m); w: 0, or VEIL_FIELD_* */
+    VEIL_V4(diffusion_inv); /* xyz: texture coordinates per m */
     veil_gpu_light lights[VEIL_MAX_LIGHTS];
     veil_gpu_fog fogs[VEIL_MAX_FOGS];
 VEIL_STRUCT_END(veil_march_block)
@@ -218,6 +221,24 @@ VEIL_FN float veil_spread_level(float w, float c, float K)
 #define VEIL_LUM_R 0.2126
 #define VEIL_LUM_G 0.7152
 #define VEIL_LUM_B 0.0722
+
+/* ---- the diffusion estimate (render/diffusion.h) ------------------------ */
+
+#define VEIL_DIFFUSION_GROUP 4  /* 4^3 cells per work group */
+#define VEIL_IMAGE_DIFF_SRC 0   /* image unit: rgba32f source S (rgb), density (a) */
+#define VEIL_IMAGE_DIFF_PHI 1   /* image unit: rgba32f fluence phi (rgb) */
+#define VEIL_UBO_DIFFUSION 2
+#define VEIL_DIFFUSION_MAX_EXTENT 1e4 /* m: a fog box larger than this gets no grid; escape paths end here */
+#define VEIL_FIELD_FLUENCE 1.0  /* veil_march_block.diffusion.w: the field is a fluence (diffusion) */
+#define VEIL_FIELD_ESCAPE 2.0   /* ... it is the octaves' gate, the chance to scatter again */
+
+VEIL_STRUCT_BEGIN(veil_diffusion_block)
+    VEIL_V4(origin);     /* xyz: the first cell's centre (m); w: cell edge h (m) */
+    VEIL_V4(sigma_a);    /* rgb: m^-1 per unit density */
+    VEIL_V4(sigma_tr);   /* rgb: transport sigma_a + sigma_s (1 - g), m^-1 per unit density; w: vacuum below this sigma_tr rho h */
+    VEIL_IV4(dims);      /* xyz: cells; w: the parity updated (red-black) */
+    VEIL_V4(relax);      /* x: over-relaxation omega */
+VEIL_STRUCT_END(veil_diffusion_block)
 
 /* Henyey–Greenstein phase function (sr^-1), cos_theta the cosine between the
  * light's travel direction and the scattered direction; g = 0 is isotropic

@@ -145,9 +145,15 @@ veil_result veil_plan_explain(const veil_scene* s, const veil_render_opts* opts,
     put(&t, "render     every frame: runs, %dx%d, step %g voxels, %d light%s%s (depends on the camera)\n", o.width,
         o.height, o.step_voxels, n, n == 1 ? "" : "s", fogs ? ", analytic fog in closed form" : "");
     const veil_multiple* ms = &s->multiple;
-    if (ms->volumetric && ms->octaves > 1)
-        put(&t, "           multiple scattering: volumetric, %d octaves (a %g, b %g, c %g) in the march\n", ms->octaves,
-            ms->octave_a, ms->octave_b, ms->octave_c);
+    if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_DIFFUSION)
+        put(&t, "           multiple scattering: the diffusion field (stage volumetric: once, %d cells along the "
+                "longest side; kept while the volume and lights are unchanged)\n", ms->diffusion_cells);
+    else if (ms->volumetric && ms->octaves > 1)
+        put(&t, "           multiple scattering: volumetric, %d octaves (a %g, b %g, c %g) in the march, gated by %s\n",
+            ms->octaves, ms->octave_a, ms->octave_b, ms->octave_c,
+            ms->octave_gate == VEIL_GATE_ESCAPE ? "the escape field (stage volumetric: once per volume, kept while "
+                                                  "the volume and medium are unchanged)"
+                                                : "the legs through each point");
     /* the spread (frame/renderer.c): only the light from behind, or single scattering's when the
      * volumetric estimate is off; whether the view is optically thin is known only after the march */
     if (!ms->screen_space)

@@ -9,6 +9,7 @@
 #include "../core/clock.h"
 #include "../core/hash.h"
 #include "../propagate/opv_set.h"
+#include "../render/diffusion.h"
 #include "../render/spread.h"
 #include "../volume/ev.h"
 
@@ -18,6 +19,7 @@ struct veil_renderer {
     veil_opv_set* opv;
     veil_march* march;
     veil_spread* spread;
+    veil_diffusion* diffusion;
     /* what the EV holds: the inject key it was made with (ev_keyed: a key
      * is held, an empty medium included), and for the report */
     uint64_t ev_key;
@@ -37,6 +39,7 @@ veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_er
     if (res == VEIL_OK) res = veil_opv_set_create(&r->opv, err);
     if (res == VEIL_OK) res = veil_march_create(&r->march, err);
     if (res == VEIL_OK) res = veil_spread_create(&r->spread, err);
+    if (res == VEIL_OK) res = veil_diffusion_create(&r->diffusion, err);
     if (res != VEIL_OK) {
         veil_renderer_destroy(r);
         return res;
@@ -52,6 +55,7 @@ void veil_renderer_destroy(veil_renderer* r)
     veil_opv_set_destroy(r->opv);
     veil_march_destroy(r->march);
     veil_spread_destroy(r->spread);
+    veil_diffusion_destroy(r->diffusion);
     free(r);
 }
 
@@ -60,6 +64,7 @@ static void forget_volume(veil_renderer* r)
 {
     veil_ev_clear(r->ev);
     veil_opv_set_clear(r->opv);
+    veil_diffusion_clear(r->diffusion);
     r->ev_keyed = 0;
     r->ev_key = 0;
     r->particles = 0;
@@ -216,6 +221,60 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
     return res;
 }
 
+/* ---- the diffusion estimate (view-independent) ------------------------ */
+
+static veil_result diffuse(veil_renderer* r, const veil_scene* s, const veil_march_desc* md,
+                           veil_diffusion_field* field, veil_render_stats* st, veil_error* err)
+{
+    veil_stage_report* rep = &st->stage[VEIL_STAGE_VOLUMETRIC];
+    const veil_multiple* m = &s->multiple;
+    int escape = m->volumetric_method == VEIL_VOLUMETRIC_OCTAVE && m->octave_gate == VEIL_GATE_ESCAPE;
+    if (!m->volumetric || (m->volumetric_method == VEIL_VOLUMETRIC_OCTAVE && !escape) || m->octaves < 2 * escape) {
+        rep->status = VEIL_STAGE_SKIPPED;
+        why(rep, "%s", m->volumetric ? "the octaves need no field (their gate is the legs through each point)"
+                                     : "no volumetric estimate (multiple_scattering.volumetric)");
+        return VEIL_OK;
+    }
+    if (md->light_count == 0) {
+        rep->status = VEIL_STAGE_SKIPPED;
+        why(rep, "no light reaches the medium");
+        return VEIL_OK;
+    }
+    /* the key: the volume, the lights (geometry and colour: the source is lit), the medium's
+     * coefficients and phase, the fogs and the grid settings; never the camera */
+    uint64_t key = veil_hash_bytes(r->ev_key, &s->medium.sigma_a, sizeof s->medium.sigma_a);
+    key = veil_hash_bytes(key, &s->medium.sigma_s, sizeof s->medium.sigma_s);
+    key = veil_hash_bytes(key, &s->medium.phase, sizeof s->medium.phase);
+    if (!escape) key = veil_hash_bytes(key, md->lights, (size_t)md->light_count * sizeof *md->lights);
+    key = veil_hash_bytes(key, &escape, sizeof escape);
+    key = veil_hash_bytes(key, &m->diffusion_cells, sizeof m->diffusion_cells);
+    key = veil_hash_bytes(key, &m->diffusion_iterations, sizeof m->diffusion_iterations);
+    for (size_t i = 0; i < s->medium.source_count; ++i)
+        if (s->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL)
+            key = veil_hash_bytes(key, &s->medium.sources[i].fog, sizeof s->medium.sources[i].fog);
+    veil_diffusion_report dr;
+    veil_result res = veil_diffusion_update(r->diffusion, md, key, escape ? (float)VEIL_FIELD_ESCAPE
+                                                                        : (float)VEIL_FIELD_FLUENCE, field, &dr, err);
+    if (res != VEIL_OK) return res;
+    rep->key = key;
+    if (dr.skipped) {
+        rep->status = VEIL_STAGE_SKIPPED;
+        why(rep, "no grid: no medium, or a fog box over %g m", VEIL_DIFFUSION_MAX_EXTENT);
+    } else if (dr.cached) {
+        rep->status = VEIL_STAGE_CACHED;
+        why(rep, "the volume, lights and medium are unchanged (%dx%dx%d cells)", dr.dims[0], dr.dims[1], dr.dims[2]);
+    } else {
+        rep->status = VEIL_STAGE_RAN;
+        if (escape)
+            why(rep, "the octaves' escape field, %dx%dx%d cells of %.4g m: view- and light-independent, kept",
+                dr.dims[0], dr.dims[1], dr.dims[2], dr.cell);
+        else
+            why(rep, "%dx%dx%d cells of %.4g m, %d red-black sweeps: view-independent, kept for the next frames",
+                dr.dims[0], dr.dims[1], dr.dims[2], dr.cell, dr.iterations);
+    }
+    return VEIL_OK;
+}
+
 /* ---- stage 4: screen-space multiple scattering ------------------------ */
 
 /* What the spread moves (docs/multiple-scattering.md): the light from
@@ -301,6 +360,14 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
                           .step_voxels = o->step_voxels, .seed = o->seed, .skip_empty = !o->no_skip,
                           .max_distance = o->max_distance, .end_distance = o->behind_distance,
                           .no_background = o->behind != NULL};
+    veil_diffusion_field field = {0};
+    double t2 = veil_now_ms();
+    res = diffuse(r, s, &md, &field, st, err);
+    glFinish();
+    st->stage[VEIL_STAGE_VOLUMETRIC].ms = veil_now_ms() - t2;
+    if (res != VEIL_OK) return res;
+    md.diffusion = &field;
+    t1 = veil_now_ms();
     res = veil_march_run(r->march, &md, images, err);
     if (res == VEIL_OK && o->behind) { /* what is behind, attenuated: T L */
         size_t pixels = (size_t)images->width * (size_t)images->height;
@@ -312,7 +379,10 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
     rep->status = VEIL_STAGE_RAN;
     const veil_multiple* ms = &s->multiple;
     why(rep, "%dx%d, %d lights, step %g voxels%s: depends on the camera, runs every frame", o->width, o->height, n,
-        o->step_voxels, ms->volumetric && ms->octaves > 1 ? ", volumetric multiple scattering (octaves)" : "");
+        o->step_voxels,
+        !ms->volumetric ? ""
+        : ms->volumetric_method == VEIL_VOLUMETRIC_DIFFUSION ? ", multiple scattering from the diffusion field"
+        : ms->octaves > 1 ? ", volumetric multiple scattering (octaves)" : "");
     if (res == VEIL_OK) res = spread(r, s, o, images, st, err);
     return res;
 }

@@ -2,7 +2,7 @@
 
 const char* veil_stage_name(veil_stage_id id)
 {
-    static const char* const names[VEIL_STAGE_COUNT] = {"inject", "propagate", "render", "spread"};
+    static const char* const names[VEIL_STAGE_COUNT] = {"inject", "propagate", "volumetric", "render", "spread"};
     return id >= 0 && id < VEIL_STAGE_COUNT ? names[id] : "?";
 }
 

@@ -13,6 +13,7 @@
 typedef enum veil_stage_id {
     VEIL_STAGE_INJECT = 0, /* sources -> extinction volume (volume/) */
     VEIL_STAGE_PROPAGATE,  /* EV -> optical-depth volumes (propagate/) */
+    VEIL_STAGE_VOLUMETRIC, /* EV (+ OPVs) -> a view-independent multiple-scattering field (render/diffusion.h) */
     VEIL_STAGE_RENDER,     /* the march: camera rays -> image set (render/) */
     VEIL_STAGE_SPREAD,     /* screen-space multiple scattering (render/spread.h) */
     VEIL_STAGE_COUNT
@@ -33,7 +34,7 @@ typedef struct veil_stage_report {
     char why[VEIL_STAGE_WHY_MAX];  /* why it ran, was cached or skipped, and what it did */
 } veil_stage_report;
 
-const char* veil_stage_name(veil_stage_id id);            /* "inject", "propagate", "render", "spread" */
+const char* veil_stage_name(veil_stage_id id);            /* "inject", "propagate", "volumetric", "render", "spread" */
 const char* veil_stage_status_name(veil_stage_status s);  /* "ran", "cached", "skipped" */
 
 #endif

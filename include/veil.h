@@ -110,7 +110,7 @@ veil_result veil_image_write_exr(const veil_image* img, const char* path, int ao
 /* 8-bit sRGB PNG preview of the radiance times 2^exposure, tone-mapped. */
 veil_result veil_image_write_png(const veil_image* img, const char* path, float exposure, veil_error* err);
 
-/* The render's stage reports ("inject", "propagate", "render", "spread"), in order:
+/* The render's stage reports ("inject", "propagate", "volumetric", "render", "spread"), in order:
  * what each did ("ran", "cached", "skipped"), its wall time (ms) and why.
  * Each output may be NULL; the strings are owned by img (names: static). */
 int veil_image_stage_count(const veil_image* img); /* 0 for NULL */

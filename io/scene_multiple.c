@@ -10,7 +10,10 @@ static const char* const MS_KEYS[] = {
     "screen_space", "volumetric", "c", "mask_epsilon", "mask", "luminance_weighting", "density_blur", "levels",
     "filter", "weights", "interpolation", "separation", "separation_luminance", "separation_luminance_width",
     "separation_density", "separation_density_width", "k_ssc", "thin_threshold", "octaves", "octave_extinction",
-    "octave_contribution", "octave_eccentricity", NULL};
+    "octave_contribution", "octave_eccentricity", "volumetric_method", "diffusion_cells", "diffusion_iterations",
+    "octave_gate", NULL};
+static const char* const GATES[] = {"legs", "escape", NULL}; /* = veil_octave_gate */
+static const char* const VOL_METHODS[] = {"octave", "diffusion", NULL}; /* = veil_volumetric_method */
 static const char* const FILTERS[] = {"2x2", "4x4", "6x6", NULL};                                 /* = veil_spread_filter */
 static const char* const INTERPS[] = {"linear-bilinear", "linear-bicubic", "cubic-bicubic", NULL}; /* = veil_spread_interp */
 
@@ -21,6 +24,8 @@ static const range R_UNIT_CLOSED = {0, 1, false, false, false, "a number in [0, 
 static const range R_UNIT_OPEN_LO = {0, 1, true, false, false, "a number in (0, 1]"};
 static const range R_UNIT_OPEN_HI = {0, 1, false, true, false, "a number in [0, 1)"};
 static const range R_OCTAVES = {1, 16, false, false, true, "an integer in [1, 16]"};
+static const range R_CELLS = {8, 256, false, false, true, "an integer in [8, 256]"};
+static const range R_ITER = {0, 100000, false, false, true, "an integer in [0, 100000] (0: 3 x the cells)"};
 
 static veil_result get_bool(const ctx* c, const cJSON* o, const jpath* pp, const char* key, int* out)
 {
@@ -89,6 +94,11 @@ veil_result veil__parse_multiple(const ctx* c, const cJSON* root, veil_multiple*
     int filter = (int)m->filter, interp = (int)m->interp;
     TRY(get_bool(c, o, &p, "screen_space", &m->screen_space));
     TRY(get_bool(c, o, &p, "volumetric", &m->volumetric));
+    int vm = (int)m->volumetric_method;
+    TRY(get_name(c, o, &p, "volumetric_method", VOL_METHODS, &vm));
+    m->volumetric_method = (veil_volumetric_method)vm;
+    TRY(veil__jr_get_int(c, o, &p, "diffusion_cells", &R_CELLS, &m->diffusion_cells));
+    TRY(veil__jr_get_int(c, o, &p, "diffusion_iterations", &R_ITER, &m->diffusion_iterations));
     TRY(get_float(c, o, &p, "c", &R_POS, &m->c));
     TRY(get_float(c, o, &p, "mask_epsilon", &R_NONNEG, &m->mask_epsilon));
     TRY(get_bool(c, o, &p, "mask", &m->mask));
@@ -114,6 +124,7 @@ veil_result veil__parse_multiple(const ctx* c, const cJSON* root, veil_multiple*
     TRY(get_float(c, o, &p, "k_ssc", &R_UNIT_CLOSED, &m->k_ssc));
     TRY(get_float(c, o, &p, "thin_threshold", &R_NONNEG, &m->thin_threshold));
     TRY(veil__jr_get_int(c, o, &p, "octaves", &R_OCTAVES, &m->octaves));
+    TRY(get_name(c, o, &p, "octave_gate", GATES, &m->octave_gate));
     TRY(get_float(c, o, &p, "octave_extinction", &R_UNIT_OPEN_LO, &m->octave_a));
     TRY(get_float(c, o, &p, "octave_contribution", &R_UNIT_OPEN_HI, &m->octave_b));
     return get_float(c, o, &p, "octave_eccentricity", &R_UNIT_CLOSED, &m->octave_c);

@@ -100,7 +100,11 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
     u->flags[2] = d->seed;
     u->flags[3] = d->end_distance != NULL;
     const veil_multiple* ms = &d->scene->multiple;
-    if (ms->volumetric && ms->octaves > 1) {
+    if (d->diffusion && d->diffusion->texture) {
+        set3(u->diffusion, d->diffusion->tex_min, d->diffusion->kind);
+        set3(u->diffusion_inv, d->diffusion->tex_inv, 0.0f);
+    }
+    if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_OCTAVE && ms->octaves > 1) {
         u->octave[0] = ms->octave_a, u->octave[1] = ms->octave_b, u->octave[2] = ms->octave_c;
         u->octave[3] = (float)ms->octaves;
     }
@@ -153,11 +157,12 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         glBindTextureUnit(VEIL_TEX_OCC, d->grid ? d->occupancy : 0);
         for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, d->opv ? d->opv[t] : 0);
         glBindTextureUnit(VEIL_TEX_LIMIT, limit);
+        glBindTextureUnit(VEIL_TEX_DIFFUSION, d->diffusion ? d->diffusion->texture : 0);
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], tex[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glDispatchCompute(veil_groups(w, VEIL_MARCH_GROUP), veil_groups(h, VEIL_MARCH_GROUP), 1);
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        for (int t = 0; t <= VEIL_TEX_LIMIT; ++t) glBindTextureUnit((GLuint)t, 0);
+        for (int t = 0; t <= VEIL_TEX_DIFFUSION; ++t) glBindTextureUnit((GLuint)t, 0);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, 0);
         glUseProgram(0);
         r = veil_gl_check("ray march (render/shaders/march.comp)", err);

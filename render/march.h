@@ -31,6 +31,14 @@
 
 typedef struct veil_march veil_march;
 
+/* A multiply scattered fluence field the march reads (render/diffusion.h). */
+typedef struct veil_diffusion_field {
+    GLuint texture;     /* rgba32f 3D, 0: none */
+    float kind;         /* VEIL_FIELD_FLUENCE or VEIL_FIELD_ESCAPE (core/shared.glsl.h) */
+    float tex_min[3];   /* texture coordinates are (x - tex_min) * tex_inv */
+    float tex_inv[3];
+} veil_diffusion_field;
+
 typedef struct veil_march_desc {
     const veil_scene* scene;   /* medium coefficients, fogs, background */
     const veil_camera* camera;
@@ -47,6 +55,7 @@ typedef struct veil_march_desc {
     const float* end_distance; /* NULL, or width*height distances (m, >= 0, +inf allowed) along each
                                   pixel's ray where it ends (a surface behind the medium) */
     int no_background;         /* 1: add no background (the caller composes what is behind) */
+    const veil_diffusion_field* diffusion; /* NULL or texture 0: none */
 } veil_march_desc;
 
 veil_result veil_march_create(veil_march** out, veil_error* err);

@@ -84,6 +84,9 @@ void veil_multiple_defaults(veil_multiple* m)
     memset(m, 0, sizeof *m);
     m->screen_space = 1;
     m->volumetric = 1;
+    m->volumetric_method = VEIL_VOLUMETRIC_OCTAVE;
+    m->diffusion_cells = 64;
+    m->diffusion_iterations = 0;
     m->c = 0.86f;
     m->mask_epsilon = 2.0f;
     m->mask = 1;
@@ -103,10 +106,12 @@ void veil_multiple_defaults(veil_multiple* m)
     m->sep_density_width = 0.5f;
     m->k_ssc = 0.7f;
     m->thin_threshold = 1e-3f;
-    /* fitted on data/scenes fog_lights, demo, cloud, vdb_smoke (bench/multiple_scattering_fit.py;
+    /* fitted on data/scenes fog_lights, demo, cloud, vdb_smoke, each at 1x and 3x density
+     * (bench/multiple_scattering_fit.py;
      * docs/multiple-scattering.md has the grid, the fit and the check on scenes it never saw) */
-    m->octaves = 3;
+    m->octaves = 10;
     m->octave_a = 0.3f;
-    m->octave_b = 0.75f;
-    m->octave_c = 0.6f;
+    m->octave_b = 0.9f;
+    m->octave_c = 0.7f;
+    m->octave_gate = VEIL_GATE_ESCAPE;
 }

@@ -122,9 +122,22 @@ typedef enum veil_spread_filter { VEIL_SPREAD_2X2 = 0, VEIL_SPREAD_4X4 = 1, VEIL
 /* VEIL_INTERP_* (core/shared.glsl.h: the fetch shader reads the same values) */
 typedef int veil_spread_interp;
 
+typedef enum veil_volumetric_method {
+    VEIL_VOLUMETRIC_OCTAVE = 0,   /* octaves in the march (render/shaders/march.comp) */
+    VEIL_VOLUMETRIC_DIFFUSION = 1 /* a diffusion solve on a coarse grid (render/diffusion.h) */
+} veil_volumetric_method;
+
+typedef enum veil_octave_gate {
+    VEIL_GATE_LEGS = 0,  /* 1 - exp(-sigma_s (D + P)): the two legs through the point (light, camera) */
+    VEIL_GATE_ESCAPE = 1 /* the chance to scatter again, averaged over 14 directions (a view-independent field) */
+} veil_octave_gate;
+
 typedef struct veil_multiple {
     int screen_space;     /* 1: the screen-space spread */
-    int volumetric;       /* 1: the octave estimate in the march */
+    int volumetric;       /* 1: a volumetric estimate, volumetric_method */
+    veil_volumetric_method volumetric_method;
+    int diffusion_cells;  /* the diffusion grid's cells along its longest side, 8..256 */
+    int diffusion_iterations; /* red-black SOR sweeps; 0: 3 x the longest side */
     /* screen-space */
     float c;              /* pixels: a level-k texel spreads by about c 2^(k-1) (paper: 0.86) */
     float mask_epsilon;   /* unitless: width of the leak mask, smoothstep(T, (1+eps) T, W) (paper: 2) */
@@ -147,6 +160,7 @@ typedef struct veil_multiple {
     float octave_a;       /* extinction scale per octave, (0, 1] */
     float octave_b;       /* contribution scale per octave, [0, 1) */
     float octave_c;       /* phase g scale per octave, [0, 1] */
+    int octave_gate;      /* VEIL_GATE_*: what scales the octaves where little medium surrounds a point */
 } veil_multiple;
 
 /* The defaults: every field as documented in docs/scene-format.md. */

@@ -33,6 +33,12 @@ grep -c '^inject .*(ran: ' "$tmp/stats.txt" | grep -qx 1 || fail "inject did not
 grep -c '^inject .*(cached: ' "$tmp/stats.txt" | grep -qx 1 || fail "frame 1 re-injected: $(cat "$tmp/stats.txt")"
 grep -c '^propagate .*(cached: ' "$tmp/stats.txt" | grep -qx 1 || fail "frame 1 re-propagated"
 grep -c '^render .*(ran: ' "$tmp/stats.txt" | grep -qx 2 || fail "render did not run on both frames"
+# the multiple-scattering field is view-independent: made once, kept for frame 1
+grep -c '^volumetric .*(ran: ' "$tmp/stats.txt" | grep -qx 1 || fail "the volumetric field did not run once: $(cat "$tmp/stats.txt")"
+grep -c '^volumetric .*(cached: ' "$tmp/stats.txt" | grep -qx 1 || fail "frame 1 rebuilt the volumetric field"
+grep -q '^volumetric .*gated by the escape field' "$tmp/plan.txt" || grep -q 'gated by the escape field' "$tmp/plan.txt" \
+    || fail "the plan does not name the octaves' gate: $(cat "$tmp/plan.txt")"
+grep -c '^spread .*(skipped: nothing to spread' "$tmp/stats.txt" | grep -qx 2 || fail "the spread was not skipped (and said why)"
 ok
 
 # fog only: inject and propagate skipped, and said why

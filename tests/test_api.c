@@ -133,14 +133,14 @@ static void render_and_read(veil_context* ctx, const veil_scene* scene)
     free(plane);
 
     int n = veil_image_stage_count(img);
-    CHECK(n == 4, "%d stages", n);
+    CHECK(n == 5, "%d stages", n);
     for (int i = 0; i < n; ++i) {
         const char *name = NULL, *status = NULL, *why = NULL;
         double ms = -1.0;
         CHECK(veil_image_stage(img, i, &name, &status, &ms, &why) == VEIL_OK, "stage %d", i);
         CHECK(name && *name && status && why && *why && ms >= 0.0, "stage %d report", i);
-        /* the spread (stage 3) has nothing to do in a volume render with the volumetric estimate on */
-        const char* want = i == 3 ? "skipped" : "ran";
+        /* the spread (stage 4) has nothing to do in a volume render with the volumetric estimate on */
+        const char* want = i == 4 ? "skipped" : "ran";
         CHECK(status && strcmp(status, want) == 0, "stage %d of a first render: %s, expected %s", i,
               status ? status : "?", want);
         CHECK(veil_image_stage(img, i, NULL, NULL, NULL, NULL) == VEIL_OK, "stage %d, no outputs", i);

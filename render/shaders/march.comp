@@ -42,13 +42,10 @@ layout(binding = VEIL_IMAGE_AOV_T, rgba32f) writeonly uniform image2D u_aov_t; /
 layout(binding = VEIL_IMAGE_AOV_S, rgba32f) writeonly uniform image2D u_aov_s; // rgb single scattering, a = depth (m)
 layout(binding = VEIL_IMAGE_AOV_V, rgba32f) writeonly uniform image2D u_aov_v; // rgb volumetric multiple scattering
 layout(binding = VEIL_IMAGE_AOV_Q, rgba32f) writeonly uniform image2D u_aov_q; // rgb out-scattered single, a = its P
-layout(binding = VEIL_TEX_EV) uniform sampler3D u_ev;
-layout(binding = VEIL_TEX_OPV0) uniform sampler3D u_opv[VEIL_MAX_OPV_TEXTURES];
 layout(binding = VEIL_TEX_OCC) uniform sampler3D u_occ; // max density per VEIL_BRICK^3 brick (ring included)
 layout(binding = VEIL_TEX_LIMIT) uniform sampler2D u_limit; // u.flags.w: distance (m) where each pixel's ray ends
-layout(std140, binding = VEIL_UBO_MARCH) uniform veil_march_ubo { veil_march_block u; };
-
-const float INF = 3.0e38;
+layout(binding = VEIL_TEX_DIFFUSION) uniform sampler3D u_phi; // u.diffusion.w: multiply scattered fluence (W/m^2)
+//@include render/shaders/medium_common.glsl
 
 uint hash32(uint x)
 {
@@ -56,42 +53,6 @@ uint hash32(uint x)
     x ^= x >> 15; x *= 0x846ca68bu;
     x ^= x >> 16;
     return x;
-}
-
-// Slab test of o + t dir, t in [tmin, tmax]; empty when .x >= .y.
-vec2 box_hit(vec3 o, vec3 dir, vec3 lo, vec3 hi, float tmin, float tmax)
-{
-    vec3 inv = 1.0 / dir; // +-inf on zero components: the slab test still holds
-    vec3 a = (lo - o) * inv, b = (hi - o) * inv;
-    vec3 t0 = min(a, b), t1 = max(a, b);
-    return vec2(max(max(t0.x, t0.y), max(t0.z, tmin)), min(min(t1.x, t1.y), min(t1.z, tmax)));
-}
-
-// Density integral of all fogs along p + t d, t in [t0, t1] (d unit).
-float fog_integral(vec3 p, vec3 d, float t0, float t1)
-{
-    float sum = 0.0;
-    for (int f = 0; f < u.size.w; ++f) {
-        vec2 s = box_hit(p, d, u.fogs[f].box_min.xyz, u.fogs[f].box_max.xyz, t0, t1);
-        if (s.x >= s.y) continue;
-        float b = u.fogs[f].origin.w;
-        float k0 = b * dot(p + d * s.x - u.fogs[f].origin.xyz, u.fogs[f].direction.xyz);
-        float k1 = b * dot(p + d * s.y - u.fogs[f].origin.xyz, u.fogs[f].direction.xyz);
-        sum += veil_exp_fog_integral(u.fogs[f].direction.w, k0, k1, s.y - s.x);
-    }
-    return sum;
-}
-
-// The EV's density integral from x to the light along unit direction `to`
-// over length `len` (INF for a sun): the optical-depth volume at x, or at
-// the point where that path enters the EV's box.
-float ev_depth(int l, vec3 x, vec3 to, float len)
-{
-    if (u.flags.x == 0u) return 0.0;
-    vec2 s = box_hit(x, to, u.box_min.xyz, u.box_max.xyz, 0.0, len);
-    if (s.x > s.y) return 0.0;
-    vec3 y = x + to * s.x;
-    return texture(u_opv[l / 4], (y - u.tex_min.xyz) * u.tex_inv_size.xyz)[l % 4];
 }
 
 // Light scattered towards -dir at x: single scattering returned, the
@@ -103,40 +64,39 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
     int octaves = int(u.octave.w);
     // each further scattering keeps the single-scattering albedo of the light
     vec3 albedo = u.sigma_s.rgb / max(u.sigma_t.rgb, vec3(1e-30));
+    // light that scattered many times is attenuated as diffusion attenuates
+    // it, sqrt(3 sigma_a sigma_tr) (sigma_tr = sigma_a + sigma_s (1 - g)):
+    // an octave's reduced extinction a^i sigma_t never goes below that
+    vec3 sigma_a = max(u.sigma_t.rgb - u.sigma_s.rgb, 0.0);
+    vec3 floor_t = sqrt(3.0 * sigma_a * (sigma_a + u.sigma_s.rgb * (1.0 - u.march.w)));
+    float escape = u.diffusion.w == VEIL_FIELD_ESCAPE
+                 ? texture(u_phi, (x - u.diffusion.xyz) * u.diffusion_inv.xyz).r : 0.0;
     for (int l = 0; l < u.size.z; ++l) {
         vec3 travel, E;
         float len;
-        if (int(u.lights[l].position.w) != VEIL_LIGHT_DIRECTIONAL) {
-            vec3 to_light = u.lights[l].position.xyz - x;
-            float r2 = max(dot(to_light, to_light), u.march.y);
-            len = sqrt(r2);
-            travel = -to_light / len;
-            E = u.lights[l].color.rgb / r2;
-            if (int(u.lights[l].position.w) == VEIL_LIGHT_SPOT)
-                E *= veil_spot_falloff(dot(travel, u.lights[l].direction.xyz), u.lights[l].direction.w, u.lights[l].color.w);
-        } else {
-            travel = u.lights[l].direction.xyz;
-            E = u.lights[l].color.rgb;
-            len = INF;
-        }
-        if (max(E.r, max(E.g, E.b)) <= 0.0) continue;
-        // a fog's closed form overflows to +inf for rho0 e^60 len > 3.4e38: keep D
-        // finite so that a channel with sigma_t = 0 gets exp(0) = 1, not exp(0 * inf) = NaN
-        float D = min(ev_depth(l, x, -travel, len) + fog_integral(x, -travel, 0.0, len), INF);
+        if (!light_at(l, x, travel, E, len)) continue;
+        float D = depth_to_light(l, x, travel, len);
         float cos_theta = clamp(dot(travel, -dir), -1.0, 1.0);
         sum += E * exp(-u.sigma_t.rgb * D) * veil_phase_hg(cos_theta, u.march.w);
         // the chance that light on the two legs through x (from the light,
         // to the camera) scattered again: no medium around x, no higher orders
         // (D + p_cam kept finite: 0 * inf would be NaN where sigma_s = 0)
-        float gate = 1.0 - exp(-dot(u.sigma_s.rgb, vec3(1.0 / 3.0)) * min(D + p_cam, INF));
-        float a = 1.0, g = u.march.w;
-        vec3 b = vec3(gate);
+        // or, with the escape field, the chance averaged over all directions
+        float gate = u.diffusion.w == VEIL_FIELD_ESCAPE ? escape
+                   : 1.0 - exp(-dot(u.sigma_s.rgb, vec3(1.0 / 3.0)) * min(D + p_cam, INF));
+        // the legs' gate counts once; the escape field's chance is paid per further scattering
+        float a = 1.0, g = u.march.w, per = u.diffusion.w == VEIL_FIELD_ESCAPE ? gate : 1.0;
+        vec3 b = vec3(u.diffusion.w == VEIL_FIELD_ESCAPE ? 1.0 : gate);
         for (int i = 1; i < octaves; ++i) {
             a *= u.octave.x, g *= u.octave.z;
-            b *= u.octave.y * albedo;
-            multi += b * E * exp(-(a * u.sigma_t.rgb) * D) * veil_phase_hg(cos_theta, g);
+            b *= u.octave.y * per * albedo;
+            multi += b * E * exp(-max(a * u.sigma_t.rgb, floor_t) * D) * veil_phase_hg(cos_theta, g);
         }
     }
+    // the diffusion estimate: the fluence of light scattered at least once,
+    // scattered again, isotropically, towards the camera
+    if (u.diffusion.w == VEIL_FIELD_FLUENCE)
+        multi += texture(u_phi, (x - u.diffusion.xyz) * u.diffusion_inv.xyz).rgb * (1.0 / (4.0 * VEIL_PI));
     return sum;
 }
 

@@ -1,0 +1,223 @@
+#include "diffusion.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../gpu/gl_util.h"
+#include "../gpu/programs.h"
+
+struct veil_diffusion {
+    GLuint source_program, sor_program, escape_program, ubo, march_ubo;
+    GLuint src, phi;    /* 3D textures of the kept field (0: none) */
+    int dims[3];
+    veil_diffusion_field field;
+    uint64_t key;
+    int keyed;          /* a field (or "none") is kept under key */
+};
+
+veil_result veil_diffusion_create(veil_diffusion** out, veil_error* err)
+{
+    *out = NULL;
+    veil_diffusion* d = calloc(1, sizeof *d);
+    if (!d) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the diffusion pass");
+    veil_result r = veil_gpu_program("render/shaders/diffusion_source.comp", &d->source_program, err);
+    if (r == VEIL_OK) r = veil_gpu_program("render/shaders/diffusion_sor.comp", &d->sor_program, err);
+    if (r == VEIL_OK) r = veil_gpu_program("render/shaders/escape.comp", &d->escape_program, err);
+    if (r == VEIL_OK)
+        r = veil_gl_buffer(NULL, sizeof(veil_diffusion_block), GL_DYNAMIC_STORAGE_BIT, "veil diffusion block", &d->ubo,
+                           err);
+    if (r == VEIL_OK)
+        r = veil_gl_buffer(NULL, sizeof(veil_march_block), GL_DYNAMIC_STORAGE_BIT, "veil diffusion march block",
+                           &d->march_ubo, err);
+    if (r != VEIL_OK) {
+        veil_diffusion_destroy(d);
+        return r;
+    }
+    *out = d;
+    return VEIL_OK;
+}
+
+void veil_diffusion_clear(veil_diffusion* d)
+{
+    if (!d) return;
+    glDeleteTextures(1, &d->src);
+    glDeleteTextures(1, &d->phi);
+    d->src = d->phi = 0;
+    memset(&d->field, 0, sizeof d->field);
+    memset(d->dims, 0, sizeof d->dims);
+    d->keyed = 0;
+}
+
+void veil_diffusion_destroy(veil_diffusion* d)
+{
+    if (!d) return;
+    veil_diffusion_clear(d);
+    glDeleteProgram(d->source_program);
+    glDeleteProgram(d->sor_program);
+    glDeleteProgram(d->escape_program);
+    glDeleteBuffers(1, &d->ubo);
+    glDeleteBuffers(1, &d->march_ubo);
+    free(d);
+}
+
+/* The grid: over the EV's medium box, cells of two voxels (at most `cells`
+ * along the longest side); without an EV over the first fog's box. 0 when
+ * there is none. */
+static int grid_of(const veil_march_desc* md, int cells, float lo[3], float* h, int dims[3])
+{
+    float hi[3];
+    if (md->grid) {
+        veil_grid_medium_box(md->grid, lo, hi);
+        *h = 2.0f * md->grid->voxel;
+    } else {
+        const veil_medium* m = &md->scene->medium;
+        size_t i = 0;
+        while (i < m->source_count && m->sources[i].type != VEIL_SOURCE_EXPONENTIAL) ++i;
+        if (i == m->source_count) return 0;
+        for (int a = 0; a < 3; ++a) lo[a] = m->sources[i].fog.bounds[0][a], hi[a] = m->sources[i].fog.bounds[1][a];
+        *h = 0.0f;
+    }
+    float longest = 0.0f;
+    for (int a = 0; a < 3; ++a) longest = fmaxf(longest, hi[a] - lo[a]);
+    if (!(longest > 0.0f) || !(longest <= VEIL_DIFFUSION_MAX_EXTENT)) return 0;
+    if (!(*h > 0.0f) || longest / *h + 1.0f > (float)cells) *h = longest / (float)(cells - 1);
+    for (int a = 0; a < 3; ++a) {
+        dims[a] = (int)ceilf((hi[a] - lo[a]) / *h) + 1;
+        if (dims[a] < 2) dims[a] = 2;
+        if (dims[a] > cells) dims[a] = cells;
+    }
+    return 1;
+}
+
+/* An rgba32f field: zero everywhere and beyond its border (phi = 0 there). */
+static veil_result texture3d(const int dims[3], const char* label, GLuint* tex, veil_error* err)
+{
+    veil_result r = veil_gl_texture3d(GL_RGBA32F, dims, label, tex, err);
+    if (r != VEIL_OK) return r;
+    glTextureParameteri(*tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    glTextureParameteri(*tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    glTextureParameteri(*tex, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_BORDER);
+    static const float zero[4] = {0, 0, 0, 0};
+    glTextureParameterfv(*tex, GL_TEXTURE_BORDER_COLOR, zero);
+    glClearTexImage(*tex, 0, GL_RGBA, GL_FLOAT, zero);
+    return veil_gl_check(label, err);
+}
+
+veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, uint64_t key, float kind,
+                                  veil_diffusion_field* field, veil_diffusion_report* rep, veil_error* err)
+{
+    memset(rep, 0, sizeof *rep);
+    rep->key = key;
+    if (d->keyed && d->key == key) {
+        *field = d->field;
+        rep->cached = 1;
+        rep->skipped = d->phi == 0;
+        memcpy(rep->dims, d->dims, sizeof rep->dims);
+        rep->cell = d->field.texture ? 1.0f / (d->field.tex_inv[0] * (float)d->dims[0]) : 0.0f;
+        return VEIL_OK;
+    }
+    veil_diffusion_clear(d);
+    memset(field, 0, sizeof *field);
+    const veil_multiple* ms = &md->scene->multiple;
+    float lo[3], h;
+    int dims[3];
+    int escape = kind == (float)VEIL_FIELD_ESCAPE;
+    if (!grid_of(md, escape ? VEIL_ESCAPE_CELLS : ms->diffusion_cells, lo, &h, dims)) {
+        d->keyed = 1, d->key = key;
+        rep->skipped = 1;
+        return VEIL_OK;
+    }
+    veil_march_block mu;
+    veil_result r = veil_march_block_fill(md, &mu, err);
+    if (r != VEIL_OK) return r;
+    const veil_medium* m = &md->scene->medium;
+    float g = m->phase.type == VEIL_PHASE_HG ? m->phase.g : 0.0f, extent = 0.0f;
+    veil_diffusion_block u;
+    memset(&u, 0, sizeof u);
+    for (int a = 0; a < 3; ++a) {
+        u.origin[a] = lo[a];
+        u.dims[a] = dims[a];
+        u.sigma_a[a] = m->sigma_a[a];
+        u.sigma_tr[a] = m->sigma_a[a] + m->sigma_s[a] * (1.0f - g);
+        extent = fmaxf(extent, (float)dims[a] * h);
+    }
+    u.origin[3] = h;
+    u.sigma_tr[3] = VEIL_DIFFUSION_VACUUM;
+    (void)extent;
+    u.relax[0] = VEIL_DIFFUSION_OMEGA;
+    r = texture3d(dims, "veil diffusion source", &d->src, err);
+    if (r == VEIL_OK) r = texture3d(dims, "veil diffusion fluence", &d->phi, err);
+    if (r != VEIL_OK) {
+        veil_diffusion_clear(d);
+        return r;
+    }
+    int longest = dims[0] > dims[1] ? (dims[0] > dims[2] ? dims[0] : dims[2]) : (dims[1] > dims[2] ? dims[1] : dims[2]);
+    int sweeps = escape ? 0 : ms->diffusion_iterations > 0 ? ms->diffusion_iterations : 3 * longest;
+    glNamedBufferSubData(d->march_ubo, 0, sizeof mu, &mu);
+    glNamedBufferSubData(d->ubo, 0, sizeof u, &u);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, d->march_ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_DIFFUSION, d->ubo);
+    glBindTextureUnit(VEIL_TEX_EV, md->grid ? md->ev : 0);
+    for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, md->opv ? md->opv[t] : 0);
+    if (escape) {
+        glUseProgram(d->escape_program);
+        glBindImageTexture(VEIL_IMAGE_DIFF_PHI, d->phi, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        glDispatchCompute(veil_groups(dims[0], VEIL_DIFFUSION_GROUP), veil_groups(dims[1], VEIL_DIFFUSION_GROUP),
+                          veil_groups(dims[2], VEIL_DIFFUSION_GROUP));
+    }
+    glUseProgram(escape ? 0 : d->source_program);
+    glBindImageTexture(VEIL_IMAGE_DIFF_SRC, d->src, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    if (!escape)
+        glDispatchCompute(veil_groups(dims[0], VEIL_DIFFUSION_GROUP), veil_groups(dims[1], VEIL_DIFFUSION_GROUP),
+                          veil_groups(dims[2], VEIL_DIFFUSION_GROUP));
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    glUseProgram(d->sor_program);
+    glBindImageTexture(VEIL_IMAGE_DIFF_SRC, d->src, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
+    glBindImageTexture(VEIL_IMAGE_DIFF_PHI, d->phi, 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+    for (int it = 0; it < sweeps; ++it)
+        for (int parity = 0; parity < 2; ++parity) {
+            u.dims[3] = parity;
+            glNamedBufferSubData(d->ubo, offsetof(veil_diffusion_block, dims), sizeof u.dims, u.dims);
+            glDispatchCompute(veil_groups((dims[0] + 1) / 2, VEIL_DIFFUSION_GROUP),
+                              veil_groups(dims[1], VEIL_DIFFUSION_GROUP), veil_groups(dims[2], VEIL_DIFFUSION_GROUP));
+            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        }
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glBindImageTexture(VEIL_IMAGE_DIFF_SRC, 0, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
+    glBindImageTexture(VEIL_IMAGE_DIFF_PHI, 0, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
+    for (int t = 0; t <= VEIL_TEX_OPV0 + VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit((GLuint)t, 0);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, 0);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_DIFFUSION, 0);
+    glUseProgram(0);
+    r = veil_gl_check("diffusion (render/shaders/diffusion_*.comp)", err);
+    if (r != VEIL_OK) {
+        veil_diffusion_clear(d);
+        return r;
+    }
+    memcpy(d->dims, dims, sizeof dims);
+    for (int a = 0; a < 3; ++a) {
+        d->field.tex_min[a] = lo[a] - 0.5f * h; /* cell centres at texel centres */
+        d->field.tex_inv[a] = 1.0f / ((float)dims[a] * h);
+    }
+    d->field.texture = d->phi;
+    d->field.kind = kind;
+    d->keyed = 1, d->key = key;
+    *field = d->field;
+    memcpy(rep->dims, dims, sizeof rep->dims);
+    rep->cell = h;
+    rep->iterations = sweeps;
+    return VEIL_OK;
+}
+
+float* veil_diffusion_readback(const veil_diffusion* d, int dims[3])
+{
+    if (!d->phi) return NULL;
+    size_t n = (size_t)d->dims[0] * (size_t)d->dims[1] * (size_t)d->dims[2] * 4;
+    float* out = malloc(n * sizeof *out);
+    if (!out) return NULL;
+    glGetTextureImage(d->phi, 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * sizeof *out), out);
+    memcpy(dims, d->dims, 3 * sizeof *dims);
+    return out;
+}

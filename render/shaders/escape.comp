@@ -1,0 +1,43 @@
+// veil — the octave estimate's gate (render/diffusion.h, "escape" field):
+// per cell of a coarse grid over the medium, the chance that light
+// scattered there scatters again before it leaves the medium, averaged over
+// directions:
+//   P_s(x) = mean over k of (1 - exp(-sigma_t tau_k(x)))
+// with tau_k the density integral from x along direction k (the 6 axes and
+// the 8 diagonals) to the end of the medium: the EV marched at one step per
+// voxel (midpoint rule) plus the fogs in closed form. View- and
+// light-independent: kept while the volume and the medium are unchanged.
+layout(local_size_x = VEIL_DIFFUSION_GROUP, local_size_y = VEIL_DIFFUSION_GROUP, local_size_z = VEIL_DIFFUSION_GROUP) in;
+layout(binding = VEIL_IMAGE_DIFF_PHI, rgba32f) writeonly uniform image3D u_out;
+layout(std140, binding = VEIL_UBO_DIFFUSION) uniform veil_diffusion_ubo { veil_diffusion_block dg; };
+//@include render/shaders/medium_common.glsl
+
+float ev_integral(vec3 x, vec3 d)
+{
+    if (u.flags.x == 0u) return 0.0;
+    vec2 s = box_hit(x, d, u.box_min.xyz, u.box_max.xyz, 0.0, INF);
+    if (s.x >= s.y) return 0.0;
+    float step = u.march.z, sum = 0.0;
+    int n = int(ceil((s.y - s.x) / step));
+    float dt = (s.y - s.x) / float(max(n, 1));
+    for (int i = 0; i < n; ++i) {
+        vec3 p = x + d * (s.x + (float(i) + 0.5) * dt);
+        sum += texture(u_ev, (p - u.tex_min.xyz) * u.tex_inv_size.xyz).r * dt;
+    }
+    return sum;
+}
+
+void main()
+{
+    ivec3 c = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(c, dg.dims.xyz))) return;
+    vec3 x = dg.origin.xyz + vec3(c) * dg.origin.w;
+    float st = dot(u.sigma_t.rgb, vec3(1.0 / 3.0)), sum = 0.0;
+    for (int k = 0; k < 14; ++k) {
+        vec3 d = k < 6 ? vec3(k / 2 == 0 ? 1.0 : 0.0, k / 2 == 1 ? 1.0 : 0.0, k / 2 == 2 ? 1.0 : 0.0) * ((k & 1) == 0 ? 1.0 : -1.0)
+                       : normalize(vec3((k & 1) == 0 ? 1.0 : -1.0, ((k - 6) & 2) == 0 ? 1.0 : -1.0, ((k - 6) & 4) == 0 ? 1.0 : -1.0));
+        float tau = min(ev_integral(x, d) + fog_integral(x, d, 0.0, VEIL_DIFFUSION_MAX_EXTENT), INF);
+        sum += 1.0 - exp(-st * tau);
+    }
+    imageStore(u_out, c, vec4(sum / 14.0, 0.0, 0.0, 0.0));
+}
