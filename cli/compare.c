@@ -13,7 +13,8 @@
  * edge dropped): the reference's noise falls B times, systematic errors
  * stay. mean_bias = mean(A RGB) / mean(REF RGB) - 1. noise is the rms of
  * the reference's standard error relative to it (same floor, binned
- * alike); rel_rmse_excess = sqrt(max(0, rel_rmse^2 - noise^2)) is the
+ * alike; a pixel whose stderr.bound is 1 adds no noise: its error is a
+ * bound, not an estimate); rel_rmse_excess = sqrt(max(0, rel_rmse^2 - noise^2)) is the
  * image's own error with the reference's noise taken out (they add in
  * quadrature, being independent).
  * Numbers are JSON numbers; "psnr_db" is null when the images' RGB are
@@ -126,6 +127,7 @@ static void print_json_number(const char* key, double v, const char* after)
 
 typedef struct extra_stats {
     double bias, noise, excess; /* noise, excess: NAN without standard errors */
+    size_t bounded;             /* reference pixels whose standard error is a bound (not counted as noise) */
 } extra_stats;
 
 static void print_json(const compare_args* a, const veil_compare_stats* st, const extra_stats* x)
@@ -175,8 +177,8 @@ static void print_text(const compare_args* a, const veil_compare_stats* st, cons
     if (a->bin > 1) printf("bin            %d (means of %dx%d pixel blocks)\n", a->bin, a->bin, a->bin);
     printf("mean_bias      %+.6g (mean RGB / reference's - 1)\n", x->bias);
     if (isfinite(x->noise))
-        printf("noise          %.6g (reference's standard error, relative)\nrel_rmse_excess %.6g (noise taken out)\n",
-               x->noise, x->excess);
+        printf("noise          %.6g (reference's standard error, relative%s)\nrel_rmse_excess %.6g (noise taken out)\n",
+               x->noise, x->bounded ? "; pixels whose error is a bound add none" : "", x->excess);
     if (a->heatmap) {
         char lo[16], hi[16], blue[16], magenta[16], yellow[16];
         decade(VEIL_COMPARE_HEATMAP_MIN, lo), decade(VEIL_COMPARE_HEATMAP_MAX, hi);
@@ -219,7 +221,7 @@ int veil_cmd_compare(int argc, char** argv)
             r = veil_fail(&err, VEIL_ERR_OOM, "%s: out of memory for a %dx%d heatmap", a.heatmap, wa, ha);
     }
     veil_compare_stats st = {0};
-    extra_stats x = {0.0, NAN, NAN};
+    extra_stats x = {0.0, NAN, NAN, 0};
     float* se = NULL;
     if (r == VEIL_OK) {
         /* the reference's standard errors, when it has them */
@@ -242,6 +244,18 @@ int veil_cmd_compare(int argc, char** argv)
             for (size_t i = 0; i < (size_t)wa * (size_t)ha; ++i) se[3 * i + (size_t)c] = plane[i];
             free(plane);
         }
+        /* a standard error that is a bound (stderr.bound = 1: every sample was the same) is no
+         * measure of noise: such pixels add none, so the noise is never overstated */
+        int bw = 0, bh = 0;
+        float* bound = NULL;
+        if (se && veil_read_exr_channel(a.reference, "stderr.bound", &bw, &bh, &bound, &ignored) == VEIL_OK &&
+            bw == wa && bh == ha)
+            for (size_t i = 0; i < (size_t)wa * (size_t)ha; ++i)
+                if (bound[i] != 0.0f) {
+                    se[3 * i] = se[3 * i + 1] = se[3 * i + 2] = 0.0f;
+                    ++x.bounded;
+                }
+        free(bound);
     }
     if (r == VEIL_OK && a.bin > 1) {
         if (a.heatmap) r = veil_fail(&err, VEIL_ERR_INVALID, "--heatmap is per pixel: leave out --bin");

@@ -4,8 +4,9 @@
  *
  * Renders the scene with the CPU path tracer (reference/pathtracer.h) and
  * writes an EXR with R, G, B, A and the standard error of each mean
- * (stderr.R, stderr.G, stderr.B). On a terminal, stderr shows a progress
- * bar with the estimated time left.
+ * (stderr.R, stderr.G, stderr.B), and stderr.bound: 1 where that error is
+ * a bound, not a sample estimate (reference/pathtracer.h). On a terminal,
+ * stderr shows a progress bar with the estimated time left.
  */
 #define _POSIX_C_SOURCE 200809L /* fileno, isatty */
 #include <math.h>
@@ -152,26 +153,33 @@ int veil_cmd_reference(int argc, char** argv)
     }
     float *rgba = NULL, *se = NULL;
     veil_pt_stats st = {0};
-    if (r == VEIL_OK) r = veil_pt_render(m, &scene, &o, &rgba, &se, &st, &err);
     int w = a.width ? (int)a.width : scene.camera.width, h = a.height ? (int)a.height : scene.camera.height;
+    unsigned char* bound = r == VEIL_OK ? calloc((size_t)w * (size_t)h, 1) : NULL;
+    if (r == VEIL_OK && !bound) r = veil_fail(&err, VEIL_ERR_OOM, "out of memory for a %dx%d image", w, h);
+    o.unresolved = bound;
+    if (r == VEIL_OK) r = veil_pt_render(m, &scene, &o, &rgba, &se, &st, &err);
     if (r == VEIL_OK) {
         size_t n = (size_t)w * (size_t)h;
-        float* planes[7];
-        for (int c = 0; c < 7; ++c) planes[c] = malloc(n * sizeof(float));
+        enum { PLANES = 8 };
+        float* planes[PLANES];
+        for (int c = 0; c < PLANES; ++c) planes[c] = malloc(n * sizeof(float));
         int ok = 1;
-        for (int c = 0; c < 7; ++c) ok &= planes[c] != NULL;
+        for (int c = 0; c < PLANES; ++c) ok &= planes[c] != NULL;
         if (!ok) {
             r = veil_fail(&err, VEIL_ERR_OOM, "out of memory for a %dx%d image", w, h);
         } else {
             for (size_t i = 0; i < n; ++i) {
                 for (int c = 0; c < 4; ++c) planes[c][i] = rgba[4 * i + (size_t)c];
                 for (int c = 0; c < 3; ++c) planes[4 + c][i] = se[3 * i + (size_t)c];
+                planes[7][i] = bound[i] ? 1.0f : 0.0f;
             }
-            static const char* const names[7] = {"R", "G", "B", "A", "stderr.R", "stderr.G", "stderr.B"};
-            r = veil_write_exr_planes(a.exr, w, h, 7, names, (const float* const*)planes, &err);
+            static const char* const names[PLANES] = {"R", "G", "B", "A", "stderr.R", "stderr.G", "stderr.B",
+                                                      "stderr.bound"};
+            r = veil_write_exr_planes(a.exr, w, h, PLANES, names, (const float* const*)planes, &err);
         }
-        for (int c = 0; c < 7; ++c) free(planes[c]);
+        for (int c = 0; c < PLANES; ++c) free(planes[c]);
     }
+    free(bound);
     if (r == VEIL_OK) {
         /* the noise level: mean standard error over the mean value, per channel mean */
         double sum = 0.0, sum_se = 0.0;

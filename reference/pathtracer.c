@@ -504,6 +504,7 @@ veil_result veil_pt_render(const veil_pt_medium* m, const veil_scene* s, const v
             }
         }
         unresolved += (uint64_t)marked;
+        if (opts->unresolved) opts->unresolved[i] = (unsigned char)marked;
     }
     if (opts->progress) opts->progress(opts->progress_user, h, h);
     if (stats) {

@@ -193,6 +193,11 @@ typedef struct veil_pt_opts {
     int stochastic_background; /* see above */
     int environment;       /* 1: background radiance also lights the medium */
     int light_sampling;    /* veil_pt_light_sampling; 0: MIS */
+    /* NULL, or width*height bytes set to 1 where a channel's standard
+     * error is the bound below ("unresolved"), 0 where it is a sample
+     * estimate: `veil reference` writes it as the channel stderr.bound, so
+     * that a comparison does not take a bound for noise. */
+    unsigned char* unresolved;
     /* Called from one thread now and then (and at the end) with the rows
      * finished so far; may be NULL. */
     void (*progress)(void* user, int rows_done, int rows_total);

@@ -77,6 +77,32 @@ json_check "j['floor'] == 2 and close(j['rel_rmse'], 0.05 * math.sqrt(mean_sq)) 
 run "$d/scaled.exr" "$d/ref.exr" --floor 2
 grep -q '^rel_rmse .*(floor 2)$' "$tmp/out" || fail "--floor 2 not stated: $(cat "$tmp/out")"
 
+# mean bias: scaled by 1.1 is +10 % energy; identical images 0
+run "$d/scaled.exr" "$d/ref.exr" --json
+json_check "close(j['mean_bias'], 0.1, 1e-5) and j['noise'] is None and j['rel_rmse_excess'] is None and j['bin'] == 1" \
+  "mean_bias"
+# the reference's standard error is 2 % of each value (all above the floor): noise 0.02, and
+# the excess is sqrt(0.1^2 - 0.02^2) = 0.09798
+run "$d/scaled.exr" "$d/ref_se.exr" --json
+json_check "close(j['noise'], 0.02, 1e-5) and close(j['rel_rmse_excess'], math.sqrt(0.01 - 0.0004), 1e-5)" "noise"
+# every error a bound: no noise is taken out
+run "$d/scaled.exr" "$d/ref_bound.exr" --json
+json_check "j['noise'] == 0 and close(j['rel_rmse_excess'], 0.1, 1e-5)" "stderr.bound"
+# --bin 2: 4x3 blocks of means; scaled stays 0.1 off, with the same bias; a block mean's
+# standard error is sqrt(sum se^2) / 4 = 0.02 sqrt(sum r^2) / 4, relative to its mean sum r / 4:
+# 0.02 sqrt(sum r^2) / sum r, which is 0.01 for equal r and at most 0.01 (1 + (dr/r)^2 / 8) for
+# the ramp's neighbours (dr / r <= 0.16 here): within [0.01, 0.0101]
+run "$d/scaled.exr" "$d/ref_se.exr" --bin 2 --json
+json_check "j['bin'] == 2 and close(j['rel_rmse'], 0.1, 1e-5) and close(j['mean_bias'], 0.1, 1e-5) \
+            and 0.00999 <= j['noise'] <= 0.0101" "--bin 2"
+run "$d/scaled.exr" "$d/ref.exr" --bin 0
+[ $rc -eq 2 ] || fail "--bin 0: exit $rc, expected 2"
+run "$d/scaled.exr" "$d/ref.exr" --bin 9
+[ $rc -eq 1 ] && grep -q "bin size 9" "$tmp/err" || fail "--bin 9 (over the 6-pixel side): exit $rc: $(cat "$tmp/err")"
+run "$d/scaled.exr" "$d/ref.exr" --bin 2 --heatmap "$d/h.png"
+[ $rc -eq 1 ] || fail "--bin with --heatmap: exit $rc, expected 1"
+no_heatmap "$d/h.png" "--bin with --heatmap"
+
 # R of pixel (3, 2) raised by 0.25: one pixel of 48 off
 run "$d/one_off.exr" "$d/ref.exr"
 expect_field max_abs 0.25 one_off; expect_field off_5pct 0.0208333 one_off
@@ -186,6 +212,6 @@ usage floor_missing "--floor needs a value" "$d/same.exr" "$d/ref.exr" --floor
 usage heatmap_missing "--heatmap needs a value" "$d/same.exr" "$d/ref.exr" --heatmap
 
 left=$(ls "$d" | sort | tr '\n' ' ')
-[ "$left" = "alpha.exr garbage.exr nan.exr one_off.exr ref.exr same.exr scaled.exr small.exr truncated.exr " ] \
+[ "$left" = "alpha.exr garbage.exr nan.exr one_off.exr ref.exr ref_bound.exr ref_se.exr same.exr scaled.exr small.exr truncated.exr " ] \
   || fail "files left behind: $(ls "$d")"
 echo PASS

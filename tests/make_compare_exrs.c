@@ -6,6 +6,8 @@
  *   alpha.exr    ref with A of pixel (0, 0) 0.75
  *   nan.exr      ref with B of pixel (5, 4) NaN
  *   small.exr    4x3 (a size mismatch)
+ *   ref_se.exr   ref with stderr.R, .G, .B = 0.02 x the value (as `veil reference` writes)
+ *   ref_bound.exr ref_se with stderr.bound = 1 everywhere (every error a bound)
  * The script knows these numbers; they are stated here once. */
 #include "io/image.h"
 
@@ -66,5 +68,25 @@ int main(int argc, char** argv)
     ok = ok && write(dir, "nan.exr", W, H, img);
 
     ok = ok && write(dir, "small.exr", 4, 3, ref);
+
+    /* the reference with standard errors, planes R G B A stderr.R/G/B (stderr.bound) */
+    static float planes[8][W * H];
+    for (int i = 0; i < W * H; ++i) {
+        for (int c = 0; c < 4; ++c) planes[c][i] = ref[4 * i + c];
+        for (int c = 0; c < 3; ++c) planes[4 + c][i] = 0.02f * ref[4 * i + c];
+        planes[7][i] = 1.0f;
+    }
+    static const char* const names[8] = {"R", "G", "B", "A", "stderr.R", "stderr.G", "stderr.B", "stderr.bound"};
+    const float* p[8];
+    for (int c = 0; c < 8; ++c) p[c] = planes[c];
+    veil_error err = {0};
+    char path[4096];
+    for (int k = 0; k < 2 && ok; ++k) {
+        snprintf(path, sizeof path, "%s/%s", dir, k ? "ref_bound.exr" : "ref_se.exr");
+        if (veil_write_exr_planes(path, W, H, k ? 8 : 7, names, p, &err) != VEIL_OK) {
+            fprintf(stderr, "make_compare_exrs: %s\n", err.msg);
+            ok = 0;
+        }
+    }
     return ok ? 0 : 1;
 }
