@@ -222,6 +222,7 @@ def main():
         plot = "; ".join([
             "set terminal pngcairo size 900,600", "set output '%s.png'" % base, "set logscale x",
             "set xlabel 'still frame (ms, llvmpipe)'", "set ylabel 'rel. RMSE of 4x4 means vs all orders (%)'",
+            "set yrange [0:120]", "set title 'each point a scene (12: 6 at two densities); above 120 % clipped'",
             "set key outside", "plot " + ", ".join("'%s' index %d with points pt %d ps 1.5 title '%s'" % (dat, i, 5 + 2 * i, n)
                                                  for i, n in enumerate(names))])
         subprocess.run(["gnuplot", "-e", plot], check=True)
