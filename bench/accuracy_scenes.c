@@ -94,6 +94,10 @@ veil_result acc_scene_load(int id, acc_scene* out, veil_error* err)
         acc_scene_free(out);
         return res;
     }
+    /* this benchmark measures the single-scattering march against max-order-1
+     * references: multiple scattering (bench/multiple_scattering.py) off */
+    out->scene.multiple.screen_space = 0;
+    out->scene.multiple.volumetric = 0;
     out->default_res = out->scene.medium.max_resolution;
     out->content_key = h;
     return VEIL_OK;
