@@ -16,7 +16,7 @@ for i in $(seq "$runs"); do
   "$veil" render "$scene" -o "$tmp/o.exr" --png "$tmp/o.png" --stats --seed "$i" "$@" > "$tmp/run$i.txt"
 done
 head -4 "$tmp/run1.txt" | sed 's/^[a-z]* *[0-9.]* ms *//' | sed 's/^/# /'
-for stage in inject propagate render write; do
+for stage in inject propagate volumetric render spread write; do
   grep -h "^$stage " "$tmp"/run*.txt | awk '{print $2}' | sort -g |
     awk -v s="$stage" -v n="$runs" '{v[NR]=$1} END {
       m = (n % 2) ? v[(n+1)/2] : (v[n/2] + v[n/2+1]) / 2;
