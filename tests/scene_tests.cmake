@@ -49,3 +49,15 @@ veil_bad_input(spot_inner_ge_outer ${BAD}/spot_inner_ge_outer.json
                "spot_inner_ge_outer.json: lights[1].inner_angle_deg: expected a number of degrees in [0, outer_angle_deg) = [0, 25), got 40")
 veil_bad_input(spot_missing_outer ${BAD}/spot_missing_outer.json
                "spot_missing_outer.json: lights[0].outer_angle_deg: missing required field (a number of degrees in (0, 180])")
+# multiple_scattering: every field named in its message, with what was expected
+veil_bad_input(ms_bad_filter ${BAD}/ms_bad_filter.json
+               "multiple_scattering.filter: expected one of \"2x2\", \"4x4\", \"6x6\", got a string (\"5x5\")")
+veil_bad_input(ms_bad_weights ${BAD}/ms_bad_weights.json
+               "multiple_scattering.weights: expected an array of 2 numbers >= 0")
+veil_bad_input(ms_bad_octaves ${BAD}/ms_bad_octaves.json
+               "multiple_scattering.octaves: expected an integer in [1, 16], got 0")
+veil_bad_input(ms_bad_gate ${BAD}/ms_bad_gate.json
+               "multiple_scattering.octave_gate: expected one of \"legs\", \"escape\", got a string (\"both\")")
+veil_bad_input(ms_bad_ramp ${BAD}/ms_bad_ramp.json
+               "multiple_scattering.separation_density_width: expected at most separation_density (1)")
+veil_bad_input(ms_not_bool ${BAD}/ms_not_bool.json "multiple_scattering.screen_space: expected true or false, got 1")

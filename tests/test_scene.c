@@ -154,6 +154,48 @@ static void test_defaults(void)
     veil_scene_free(&s);
 }
 
+/* "multiple_scattering": absent -> veil_multiple_defaults(); given fields
+ * replace them; a filter's weights are normalised to sum 1. */
+static void test_multiple(void)
+{
+    veil_scene s;
+    veil_error e = {0};
+    veil_multiple d;
+    veil_multiple_defaults(&d);
+    veil_result r = parse("ms.json", "{" CAM "," MED "}", &s, &e);
+    CHECK(r == VEIL_OK && memcmp(&s.multiple, &d, sizeof d) == 0, "absent: the defaults (%s)", e.msg);
+    CHECK(d.screen_space && d.volumetric && d.filter == VEIL_SPREAD_4X4 && d.weights[0] == 0.13f &&
+          d.weights[1] == 0.37f && d.c == 0.86f && d.mask_epsilon == 2.0f && d.k_ssc == 0.7f,
+          "the paper's constants are the defaults");
+    veil_scene_free(&s);
+    r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'screen_space':false,'volumetric':true,"
+              "'volumetric_method':'diffusion','filter':'6x6','weights':[1,2,3,3,2,1],"
+              "'interpolation':'cubic-bicubic','c':1.5,'levels':5,'octaves':4,'octave_gate':'legs',"
+              "'separation':true,'separation_density':2,'separation_density_width':2}}", &s, &e);
+    CHECK(r == VEIL_OK, "a full object: %s", e.msg);
+    if (r == VEIL_OK) {
+        const veil_multiple* m = &s.multiple;
+        CHECK(!m->screen_space && m->volumetric && m->volumetric_method == VEIL_VOLUMETRIC_DIFFUSION &&
+              m->filter == VEIL_SPREAD_6X6 && m->interp == VEIL_INTERP_CUBIC_BICUBIC && m->c == 1.5f &&
+              m->levels == 5 && m->octaves == 4 && m->octave_gate == VEIL_GATE_LEGS && m->separation &&
+              m->sep_density == 2.0f && m->sep_density_width == 2.0f, "values read");
+        double sum = 0.0;
+        for (int i = 0; i < 6; ++i) sum += m->weights[i];
+        CHECK(fabs(sum - 1.0) < 1e-6 && fabsf(m->weights[2] - 0.25f) < 1e-7f, "weights normalised: sum %g, w2 %g",
+              sum, m->weights[2]);
+        CHECK(m->mask == d.mask && m->octave_a == d.octave_a, "fields not given keep their defaults");
+    }
+    veil_scene_free(&s);
+    r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'filter':'2x2','weights':[0,0]}}", &s, &e);
+    CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.weights: expected 2 weights with a positive"),
+          "zero weights refused: %s", e.msg);
+    r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'c':0}}", &s, &e);
+    CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.c: expected a number > 0"), "c = 0: %s", e.msg);
+    r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'octave_contribution':1}}", &s, &e);
+    CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "octave_contribution: expected a number in [0, 1)"), "b = 1: %s",
+          e.msg);
+}
+
 typedef struct bad_case {
     const char* json;
     veil_result code;
@@ -443,6 +485,7 @@ int main(void)
 {
     test_full();
     test_defaults();
+    test_multiple();
     test_bad();
     test_spot();
     test_exact_messages();
