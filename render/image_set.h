@@ -12,8 +12,8 @@
  *   aov_s  single scattering (R, G, B: the medium's own light, background
  *          excluded) and depth, the mean distance (m) of the ray's first
  *          interaction, 0 where the ray meets no medium
- *   aov_v  volumetric multiple scattering (R, G, B: the octave estimate;
- *          0 when it is off); A unused
+ *   aov_v  volumetric multiple scattering (R, G, B: the octave or the
+ *          diffusion estimate; 0 when it is off); A unused
  *   aov_m  screen-space multiple scattering (R, G, B: the spread light;
  *          0 when the pass is off or skipped); A: the MIP level read
  *   aov_q  (not written to files) the screen-space pass's source: single

@@ -44,7 +44,14 @@ void veil_spread_destroy(veil_spread* s)
 
 int veil_spread_levels(const veil_multiple* m, int w, int h)
 {
-    if (m->levels > 0) return m->levels < VEIL_SPREAD_MAX_LEVEL ? m->levels : VEIL_SPREAD_MAX_LEVEL;
+    if (m->levels > 0) {
+        /* a level whose texel spans the whole image adds nothing (and would pad the
+         * chains far beyond it): at most ceil(log2(the larger side)) */
+        int side = w > h ? w : h, top = 0;
+        while ((1 << top) < side) ++top;
+        int k = m->levels < VEIL_SPREAD_MAX_LEVEL ? m->levels : VEIL_SPREAD_MAX_LEVEL;
+        return k < top ? k : (top > 0 ? top : 1);
+    }
     int side = w < h ? w : h, k = 0;
     while ((2 << k) <= side) ++k; /* k = floor(log2(side)) */
     k -= 1;

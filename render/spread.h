@@ -12,9 +12,10 @@
  * was read from (a); the caller adds it to the march's radiance, which
  * already holds the attenuated background T L and the single scattering.
  *
- * Levels: K = multiple.levels, or from the image size (0): floor(log2 of
- * the smaller side) - 1, at most 7 (a spread of c 2^7 = 110 pixels at the
- * paper's c). The chains' level 0 is the image padded with zeros to a
+ * Levels: K = multiple.levels (at most ceil(log2 of the larger side): a
+ * coarser level would span more than the image), or from the image size
+ * (0): floor(log2 of the smaller side) - 1, at most 7 (a spread of c 2^7 =
+ * 110 pixels at the paper's c). The chains' level 0 is the image padded with zeros to a
  * multiple of 2^K on each side, so every level halves exactly.
  *
  * Needs the GL context current at creation and for every run.
