@@ -35,7 +35,9 @@
  *    The leak mask must not change a constant-W image (every pixel is
  *    whole in the levels it is read from): this runs with it on.
  * 3. P -> 0 everywhere: the output is 0 (no spread where nothing scatters),
- *    and no NaN for absurd densities (P = 1e30). */
+ *    and no NaN for absurd densities (P = 1e30).
+ * 4. No popping in a turntable: the result is continuous across a level
+ *    boundary (below). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -162,6 +164,38 @@ int main(void)
         printf("MIP chains vs gathering, %s, w = %.2f px: relative RMSE %.4f\n", pass == 0 ? "smooth blobs" : "impulses",
                t.w_px, rel);
         if (pass == 0) CHECK(rel < bound, "MIP vs gathering on smooth blobs: %.4f >= %.2f", rel, bound);
+    }
+
+    /* 4. no popping: across a level boundary (w = c 2^3, level 3.0) the result moves
+     * continuously. P -> P (1 +- 1e-3) moves w by about 1.5e-3 relative and the level by
+     * 2e-3 (k = log2 w + const); with interpolation between levels the image moves by at
+     * most that fraction of the difference between levels 2 and 3 (< 100 %), so well under 1 %
+     * (the linear transmittance factor 1 - e^-P moves it by 1e-3 more); reading the nearest
+     * level would jump by the whole difference. */
+    {
+        float Pb = 0.05f;
+        make(&t, Pb, blobs);
+        for (int it = 0; it < 400 && t.w_px < 0.86f * 8.0f; ++it) make(&t, Pb *= 1.01f, blobs);
+        for (int it = 0; it < 60; ++it) { /* bisect to the boundary */
+            float lo = Pb / 1.01f, hi = Pb, mid = 0.5f * (lo + hi);
+            make(&t, mid, blobs);
+            if (t.w_px < 0.86f * 8.0f) lo = mid; else hi = mid;
+            Pb = hi;
+            if (hi - lo < 1e-6f * hi) break;
+        }
+        float* below = malloc(floats * sizeof(float));
+        make(&t, Pb * (1.0f - 1e-3f), blobs);
+        CHECK(run(sp, &t, &err) == VEIL_OK, "%s", err.msg);
+        memcpy(below, t.out, floats * sizeof(float));
+        make(&t, Pb * (1.0f + 1e-3f), blobs);
+        CHECK(run(sp, &t, &err) == VEIL_OK, "%s", err.msg);
+        double num = 0.0, den = 0.0;
+        for (size_t i = 0; i < floats; ++i)
+            if (i % 4 != 3) num += (t.out[i] - below[i]) * (double)(t.out[i] - below[i]), den += (double)below[i] * below[i];
+        double rel = sqrt(num / den);
+        printf("level boundary (w = %.3f px): the image moves by %.2g relative\n", t.w_px, rel);
+        CHECK(rel < 0.01, "across the level-3 boundary the spread jumps by %.3g (>= 1 %%)", rel);
+        free(below);
     }
 
     /* 3. nothing scatters: nothing spreads; absurd P: no NaN */
