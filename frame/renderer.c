@@ -259,7 +259,8 @@ static veil_result diffuse(veil_renderer* r, const veil_scene* s, const veil_mar
     rep->key = key;
     if (dr.skipped) {
         rep->status = VEIL_STAGE_SKIPPED;
-        why(rep, "no grid: no medium, or a fog box over %g m", VEIL_DIFFUSION_MAX_EXTENT);
+        why(rep, "no grid: no medium, or a fog box over %g m%s", VEIL_DIFFUSION_MAX_EXTENT,
+            escape ? " (the octaves fall back to the legs gate)" : "");
     } else if (dr.cached) {
         rep->status = VEIL_STAGE_CACHED;
         why(rep, "the volume, lights and medium are unchanged (%dx%dx%d cells)", dr.dims[0], dr.dims[1], dr.dims[2]);

@@ -82,6 +82,7 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
         // to the camera) scattered again: no medium around x, no higher orders
         // (D + p_cam kept finite: 0 * inf would be NaN where sigma_s = 0)
         // or, with the escape field, the chance averaged over all directions
+        // (without a field, e.g. a fog box too large for a grid, the legs serve)
         float gate = u.diffusion.w == VEIL_FIELD_ESCAPE ? escape
                    : 1.0 - exp(-dot(u.sigma_s.rgb, vec3(1.0 / 3.0)) * min(D + p_cam, INF));
         // the legs' gate counts once; the escape field's chance is paid per further scattering
