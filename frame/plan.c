@@ -98,6 +98,7 @@ veil_result veil_plan_explain(const veil_scene* s, const veil_render_opts* opts,
     } else {
         put(&t, "inject     frame 0: runs, key %016llx: %zu particles, %zu VDB voxels -> grid %dx%dx%d, voxel %.4g m\n",
             (unsigned long long)ev_key, v.particle_count, v.vdb_voxels, g->dims[0], g->dims[1], g->dims[2], g->voxel);
+        put(&t, "           %s\n", v.resolution);
         if (frames > 1) {
             put(&t, "           ");
             later_frames(&t, frames);

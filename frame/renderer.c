@@ -164,9 +164,9 @@ static veil_result inject_scene(veil_renderer* r, const veil_scene* s, veil_rend
         } else {
             const veil_grid* g = &v.grid;
             rep->status = VEIL_STAGE_RAN;
-            why(rep, "%s: %zu particles, %zu VDB voxels, grid %dx%dx%d, voxel %.4g m",
+            why(rep, "%s: %zu particles, %zu VDB voxels, grid %dx%dx%d, voxel %.4g m (%s)",
                 had ? "the sources changed" : "no volume kept", er.particles, er.vdb_voxels, g->dims[0], g->dims[1],
-                g->dims[2], g->voxel);
+                g->dims[2], g->voxel, v.resolution);
         }
     }
     veil_scene_volume_close(&v);

@@ -94,6 +94,7 @@ static veil_result parse_medium(const ctx* c, const cJSON* root, veil_medium* m)
     TRY(veil__jr_get_floats(c, o, &p, "sigma_s", true, 3, true, m->sigma_s));
     TRY(parse_phase(c, o, &p, &m->phase));
     TRY(veil__jr_get_int(c, o, &p, "max_resolution", &VEIL__R_RES, &m->max_resolution));
+    m->max_resolution_set = cJSON_GetObjectItemCaseSensitive(o, "max_resolution") != NULL;
     return veil__parse_sources(c, o, &p, m);
 }
 

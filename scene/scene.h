@@ -90,6 +90,10 @@ typedef struct veil_medium {
     float sigma_s[3]; /* m^-1 per unit density */
     veil_phase phase; /* default isotropic */
     int max_resolution; /* voxels along the longest side of the EV */
+    /* 1: max_resolution was given (a cap the user chose). 0: the default,
+     * which applies to particles only: a VDB source then keeps its own
+     * voxels (volume/scene_volume.h, "native resolution"). */
+    int max_resolution_set;
     veil_source* sources; /* owned */
     size_t source_count;
 } veil_medium;

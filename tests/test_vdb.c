@@ -5,7 +5,7 @@
  *
  * One ctest per CASE (tests/vdb_tests.cmake): open, select, level_set,
  * types, bad_files, empty, transform, threads, fast_path, mass, rotated,
- * limits, scene_volume.
+ * limits, scene_volume, native.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
@@ -663,6 +663,87 @@ static void test_scene_volume(void)
     CHECK(unlink(path) == 0 && rmdir(dir) == 0, "cleaning %s: %s", dir, strerror(errno));
 }
 
+/* Native resolution (volume/scene_volume.h): without medium.max_resolution
+ * a VDB keeps its own voxels. offset_scaled.vdb (axis-aligned, voxel
+ * 0.25 m, index 0..15) must come out on its own lattice with every value
+ * copied bit for bit (each EV voxel centre on an index point; the support's
+ * ring of zeros around it); with max_resolution 8 it is resampled to 8
+ * voxels along its longest side and says so; the rotated grid keeps its
+ * voxel edge (0.05 m) but is resampled, and says why. */
+static veil_result open_scene(const char* file, const char* extra, veil_scene* s, veil_scene_volume* v)
+{
+    char path[4200], json[8800];
+    snprintf(path, sizeof path, "%s/%s", g_dir, file);
+    snprintf(json, sizeof json,
+             "{\"camera\": {\"position\": [0, 0, 9], \"look_at\": [0, 0, 0]},"
+             " \"medium\": {\"sigma_s\": [1, 1, 1]%s, \"sources\": [{\"type\": \"vdb\", \"file\": \"%s\"}]}}",
+             extra, path);
+    veil_error err = {0};
+    veil_result r = veil_scene_parse("native.json", json, strlen(json), s, &err);
+    if (r == VEIL_OK) r = veil_scene_volume_open(s, v, &err);
+    if (r != VEIL_OK) fprintf(stderr, "%s\n", err.msg);
+    return r;
+}
+
+static void test_native(void)
+{
+    veil_scene s;
+    veil_scene_volume v;
+    veil_error err = {0};
+    memset(&v, 0, sizeof v);
+    if (open_scene("offset_scaled.vdb", "", &s, &v) != VEIL_OK) {
+        CHECK(0, "open offset_scaled.vdb");
+        return;
+    }
+    if (v.has_volume) {
+        printf("offset_scaled: %s\n", v.resolution);
+        CHECK(v.grid.voxel == 0.25f && strncmp(v.resolution, "native", 6) == 0, "native: voxel %g, '%s'",
+              v.grid.voxel, v.resolution);
+        /* index i sits at world 1 + i/4 (x), -2 + j/4, 3 + k/4: the first voxel centre's index */
+        int first[3];
+        const double t[3] = {1.0, -2.0, 3.0};
+        for (int a = 0; a < 3; ++a) first[a] = (int)lround((v.grid.origin[a] + 0.5 * v.grid.voxel - t[a]) / 0.25);
+        CHECK(first[0] == -1 && first[1] == -1 && first[2] == -1 && v.grid.dims[0] == 18, "the lattice: first index "
+              "(%d, %d, %d), %d voxels a side (expected -1 and 18: the support's ring)", first[0], first[1], first[2],
+              v.grid.dims[0]);
+        float* d = NULL;
+        CHECK(veil_scene_volume_density(&v, &d, &err) == VEIL_OK, "%s", err.msg);
+        int lo[3] = {first[0], first[1], first[2]};
+        int hi[3] = {first[0] + v.grid.dims[0] - 1, first[1] + v.grid.dims[1] - 1, first[2] + v.grid.dims[2] - 1};
+        size_t n = veil_grid_voxels(&v.grid);
+        float* want = malloc(n * sizeof *want);
+        CHECK(want && veil_vdb_dense(v.vdbs[0], lo, hi, want) == VEIL_OK, "dense read");
+        size_t differ = 0;
+        for (size_t i = 0; d && want && i < n; ++i) differ += memcmp(&d[i], &want[i], sizeof(float)) != 0;
+        CHECK(differ == 0, "%zu of %zu voxels are not the VDB's values bit for bit", differ, n);
+        free(d);
+        free(want);
+    }
+    veil_scene_volume_close(&v);
+    veil_scene_free(&s);
+
+    if (open_scene("offset_scaled.vdb", ", \"max_resolution\": 8", &s, &v) != VEIL_OK) {
+        CHECK(0, "open with a cap");
+        return;
+    }
+    int longest = v.grid.dims[0] > v.grid.dims[1] ? v.grid.dims[0] : v.grid.dims[1];
+    longest = longest > v.grid.dims[2] ? longest : v.grid.dims[2];
+    CHECK(longest == 8 && strstr(v.resolution, "resampled") && strstr(v.resolution, "max_resolution"),
+          "a cap the user chose: %d voxels, '%s'", longest, v.resolution);
+    veil_scene_volume_close(&v);
+    veil_scene_free(&s);
+
+    if (open_scene("rotated.vdb", "", &s, &v) != VEIL_OK) {
+        CHECK(0, "open rotated.vdb");
+        return;
+    }
+    printf("rotated: %s, grid %dx%dx%d\n", v.resolution, v.grid.dims[0], v.grid.dims[1], v.grid.dims[2]);
+    CHECK(fabsf(v.grid.voxel - 0.05f) < 1e-6f && strstr(v.resolution, "rotated"), "rotated: voxel %g, '%s'",
+          v.grid.voxel, v.resolution);
+    veil_scene_volume_close(&v);
+    veil_scene_free(&s);
+}
+
 int main(int argc, char** argv)
 {
     if (argc != 3) {
@@ -677,7 +758,7 @@ int main(int argc, char** argv)
                  {"types", test_types},     {"bad_files", test_bad_files}, {"empty", test_empty},
                  {"transform", test_transform}, {"threads", test_threads}, {"fast_path", test_fast_path},
                  {"mass", test_mass},       {"rotated", test_rotated},     {"limits", test_limits},
-                 {"scene_volume", test_scene_volume}};
+                 {"scene_volume", test_scene_volume}, {"native", test_native}};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i)
         if (strcmp(argv[2], cases[i].name) == 0) {
             cases[i].fn();

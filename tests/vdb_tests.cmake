@@ -38,6 +38,8 @@ veil_vdb_case(limits unit)
 # a scene's VDB source: veil_scene_volume_open with err == NULL on a missing
 # and a corrupt file; veil_scene_volume_key is the file's identity, not its bytes
 veil_vdb_case(scene_volume unit)
+# native resolution: a VDB without max_resolution keeps its voxels (values copied)
+veil_vdb_case(native "unit;accuracy")
 
 # `veil info` (tests/vdb_bad.sh VEIL EXPECTED_EXIT EXPECTED_TEXT ARGS...).
 function(veil_vdb_cli name rc text)

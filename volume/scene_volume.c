@@ -1,6 +1,8 @@
 #define _POSIX_C_SOURCE 200809L /* stat: st_mtim */
 #include "scene_volume.h"
 
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -71,6 +73,7 @@ static uint64_t hash_file_identity(uint64_t k, const char* path)
 uint64_t veil_scene_volume_key(const veil_scene* s)
 {
     uint64_t k = veil_hash_bytes(VEIL_FNV_OFFSET, &s->medium.max_resolution, sizeof s->medium.max_resolution);
+    k = veil_hash_bytes(k, &s->medium.max_resolution_set, sizeof s->medium.max_resolution_set);
     for (size_t i = 0; i < s->medium.source_count; ++i) {
         const veil_source* src = &s->medium.sources[i];
         if (src->type == VEIL_SOURCE_EXPONENTIAL) continue; /* never voxelised */
@@ -104,6 +107,85 @@ int veil_scene_volume_needed(const veil_scene* s)
     return 0;
 }
 
+/* The native grid over [lo, hi] (module comment in scene_volume.h): 1 when
+ * it applies (and *g, note are set), 0 to fit to max_resolution instead. */
+static int native_grid(const veil_scene_volume* v, const float lo[3], const float hi[3], veil_grid* g, char* note,
+                       size_t note_len)
+{
+    double edge = HUGE_VAL, origin[3] = {0, 0, 0};
+    int aligned = 0, which = -1;
+    for (int i = 0; i < v->vdb_count; ++i) {
+        double e, o[3];
+        int al;
+        if (!veil_vdb_lattice(v->vdbs[i], &e, o, &al)) continue;
+        /* the finest edge; among equal ones, one whose cubes are axis-aligned */
+        if (e < edge * (1.0 - VEIL_VDB_ALIGN_TOL) || (fabs(e - edge) <= VEIL_VDB_ALIGN_TOL * edge && al && !aligned)) {
+            edge = e, aligned = al, which = i;
+            memcpy(origin, o, sizeof o);
+        }
+    }
+    if (which < 0) return 0;
+    double n = 1.0;
+    int dims[3];
+    double org[3];
+    for (int a = 0; a < 3; ++a) {
+        /* index points covering [lo, hi]; the voxel centres sit on them when aligned */
+        double base = aligned ? origin[a] : (double)lo[a];
+        /* (lo, hi are floats: allow their rounding, VEIL_VDB_ALIGN_TOL of a voxel) */
+        double i0 = floor(((double)lo[a] - base) / edge + VEIL_VDB_ALIGN_TOL);
+        double i1 = ceil(((double)hi[a] - base) / edge - VEIL_VDB_ALIGN_TOL);
+        double d = fmax(i1 - i0 + 1.0, 2.0);
+        if (d > VEIL_SCENE_MAX_RESOLUTION) {
+            snprintf(note, note_len, "resampled: the VDB's %.4g m voxels make %.0f along an axis (at most %d)", edge, d,
+                     VEIL_SCENE_MAX_RESOLUTION);
+            return 0;
+        }
+        dims[a] = (int)d;
+        org[a] = base + (i0 - 0.5) * edge;
+        n *= d;
+    }
+    if (n > (double)VEIL_NATIVE_MAX_VOXELS) {
+        snprintf(note, note_len, "resampled: the VDB's %.4g m voxels make a %dx%dx%d grid, over the dense cap of "
+                 "%zu voxels", edge, dims[0], dims[1], dims[2], (size_t)VEIL_NATIVE_MAX_VOXELS);
+        return 0;
+    }
+    for (int a = 0; a < 3; ++a) g->dims[a] = dims[a], g->origin[a] = (float)org[a];
+    g->voxel = (float)edge;
+    if (aligned)
+        snprintf(note, note_len, "native: the VDB's %.4g m voxels, %dx%dx%d, values copied", edge, dims[0], dims[1],
+                 dims[2]);
+    else
+        snprintf(note, note_len, "native voxel size %.4g m, resampled (box filter): the VDB's voxels are rotated "
+                 "or not cubes", edge);
+    return 1;
+}
+
+/* The grid over [lo, hi]: native for VDBs without an explicit max_resolution, else fitted. */
+static veil_result choose_grid(const veil_scene* s, veil_scene_volume* v, const float lo[3], const float hi[3],
+                               veil_error* err)
+{
+    v->resolution[0] = 0;
+    if (!s->medium.max_resolution_set && v->vdb_count > 0 &&
+        native_grid(v, lo, hi, &v->grid, v->resolution, sizeof v->resolution))
+        return VEIL_OK;
+    int res = s->medium.max_resolution;
+    if (!s->medium.max_resolution_set && v->resolution[0]) {
+        /* the native grid is too large: the finest that fits the cap, as a cube root of it */
+        res = (int)cbrt((double)VEIL_NATIVE_MAX_VOXELS);
+        if (res > VEIL_SCENE_MAX_RESOLUTION) res = VEIL_SCENE_MAX_RESOLUTION;
+    }
+    veil_result r = veil_grid_fit(lo, hi, res, &v->grid, err);
+    if (r == VEIL_OK && !v->resolution[0])
+        snprintf(v->resolution, sizeof v->resolution, "%s: %d voxels along the longest side%s",
+                 v->vdb_count ? "resampled" : "fitted", res,
+                 s->medium.max_resolution_set ? " (medium.max_resolution)" : " (the default for particles)");
+    else if (r == VEIL_OK) {
+        size_t len = strlen(v->resolution);
+        snprintf(v->resolution + len, sizeof v->resolution - len, "; %d voxels along the longest side", res);
+    }
+    return r;
+}
+
 veil_result veil_scene_volume_open(const veil_scene* s, veil_scene_volume* out, veil_error* err)
 {
     veil_scene_volume v;
@@ -117,7 +199,7 @@ veil_result veil_scene_volume_open(const veil_scene* s, veil_scene_volume* out, 
         if (s->medium.sources[i].type == VEIL_SOURCE_VDB) r = open_vdb(&v, &s->medium.sources[i], i, lo, hi, &any, err);
     if (r == VEIL_OK) {
         if (veil_rbf_bounds(v.particles, v.particle_count, a, b)) grow(lo, hi, &any, a, b);
-        if (any) r = veil_grid_fit(lo, hi, s->medium.max_resolution, &v.grid, err);
+        if (any) r = choose_grid(s, &v, lo, hi, err);
         v.has_volume = any;
     }
     if (r != VEIL_OK) {

@@ -3,9 +3,10 @@
  * The extinction volume of a scene is made from its RBF particles (explicit
  * and generated) and its OpenVDB grids; analytic fog is never voxelised.
  * veil_scene_volume_open() collects the particles, opens the grids, fits
- * the grid that holds them all (veil_grid_fit over the union of the
- * particles' cut-off boxes and the grids' supports, medium.max_resolution
- * voxels along the longest side) and forms a content key. The GPU renderer
+ * the grid that holds them all (over the union of the particles' cut-off
+ * boxes and the grids' supports: at the VDBs' native resolution, or
+ * medium.max_resolution voxels along the longest side; see below) and forms
+ * a content key. The GPU renderer
  * then splats the particles on the GPU; the CPU reference
  * (veil_scene_volume_density) splats them with veil_inject_rbf_cpu. Both
  * resample the grids with veil_vdb_to_grid first, so the two see the same
@@ -35,7 +36,20 @@ typedef struct veil_scene_volume {
     uint64_t key;      /* veil_scene_volume_key() of the scene */
     int has_volume;    /* 0: nothing to voxelise (then `grid` is unset) */
     veil_grid grid;
+    /* How the grid was chosen, for --stats: "native: ..." or "resampled: ..." */
+    char resolution[192];
 } veil_scene_volume;
+
+/* Native resolution. When the scene gives no medium.max_resolution and has
+ * VDB sources, the grid takes the finest VDB voxel edge (not the default
+ * 128 voxels), placed on the lattice of the first VDB with that edge whose
+ * voxels are axis-aligned cubes, so that its values are copied exactly
+ * (volume/vdb_volume.h); a rotated or sheared VDB is resampled at its own
+ * voxel edge (box filter). Above VEIL_NATIVE_MAX_VOXELS voxels (or 2048 a
+ * side) the grid is resampled down to fit, and says so. An explicit
+ * max_resolution is a cap the user chose: the grid is fitted to it as
+ * before. */
+#define VEIL_NATIVE_MAX_VOXELS ((size_t)1 << 27) /* 512 MiB of float density */
 
 /* The key of the volume a scene's sources make, from their descriptions
  * alone: the resolution, explicit particles, the random generators'

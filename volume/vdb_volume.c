@@ -390,3 +390,25 @@ veil_result veil_vdb_to_grid(const veil_vdb* v, float density_scale, const veil_
     return plan.exact_copy ? copy_values(v, density_scale, g, &plan, density, err)
                            : box_filter(v, density_scale, g, &plan, density, err);
 }
+
+int veil_vdb_lattice(const veil_vdb* v, double* edge, double origin[3], int* axis_aligned)
+{
+    vdb_geometry geo;
+    veil_error ignored = {{0}};
+    if (geometry(v, &geo, &ignored) != VEIL_OK || geo.active == 0) return 0;
+    /* the world length of one index step along each index axis (a column's norm) */
+    double smallest = HUGE_VAL;
+    for (int c = 0; c < 3; ++c) {
+        double n = sqrt(geo.m[0][c] * geo.m[0][c] + geo.m[1][c] * geo.m[1][c] + geo.m[2][c] * geo.m[2][c]);
+        smallest = fmin(smallest, n);
+    }
+    if (!(smallest > 0.0) || !isfinite(smallest)) return 0;
+    *edge = smallest;
+    const double s = geo.m[0][0];
+    int aligned_axes = s > 0.0;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) aligned_axes &= r == c ? geo.m[r][c] == s : geo.m[r][c] == 0.0;
+    *axis_aligned = aligned_axes;
+    for (int a = 0; a < 3; ++a) origin[a] = geo.m[a][3];
+    return 1;
+}

@@ -94,4 +94,12 @@ veil_result veil_vdb_plan_resample(const veil_vdb* v, const veil_grid* g, veil_v
 veil_result veil_vdb_to_grid(const veil_vdb* v, float density_scale, const veil_grid* g, float* density,
                              veil_error* err);
 
+/* The grid's lattice: 1 and its smallest voxel edge (the world length of
+ * one index step along the shortest index axis, m) when it has active
+ * voxels and an affine transform, else 0. *axis_aligned is 1 when the
+ * transform is a uniform scale plus a translation (the voxels are
+ * axis-aligned cubes of edge *edge), and origin is then the world position
+ * of index (0, 0, 0). */
+int veil_vdb_lattice(const veil_vdb* v, double* edge, double origin[3], int* axis_aligned);
+
 #endif
