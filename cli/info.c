@@ -25,6 +25,18 @@ static void print_info_grid(const veil_vdb_grid_info* g)
     for (int r = 0; g->affine && r < 4; ++r)
         printf("               [%10.6g %10.6g %10.6g %10.6g]\n", g->index_to_world[r][0], g->index_to_world[r][1],
                g->index_to_world[r][2], g->index_to_world[r][3]);
+    /* what `veil render` does with it when the scene sets no max_resolution (volume/scene_volume.h) */
+    int cubes = g->affine;
+    const double s = g->index_to_world[0][0];
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) cubes &= r == c ? g->index_to_world[r][c] == s && s > 0.0 : g->index_to_world[r][c] == 0.0;
+    if (!g->affine)
+        printf("  rendering    not renderable: its transform is not affine\n");
+    else if (cubes)
+        printf("  rendering    native: axis-aligned %g m cubes, values copied (without medium.max_resolution)\n", s);
+    else
+        printf("  rendering    resampled at its smallest voxel edge (box filter): its voxels are rotated or not "
+               "cubes\n");
 }
 
 int veil_cmd_info(int argc, char** argv)
