@@ -11,6 +11,8 @@
 #include <openvdb/io/File.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetUtil.h>
+#include <nanovdb/util/IO.h>
+#include <nanovdb/util/NanoToOpenVDB.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -18,6 +20,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdarg>
@@ -121,6 +124,50 @@ std::string list_grids(const openvdb::GridPtrVec& grids)
     return s.empty() ? "no grids" : s;
 }
 
+// A NanoVDB file (.nvdb, as pbrt-v4's scenes ship): by its name's suffix.
+bool is_nanovdb(const std::string& path)
+{
+    if (path.size() < 5) return false;
+    std::string ext = path.substr(path.size() - 5);
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return (char)std::tolower(c); });
+    return ext == ".nvdb";
+}
+
+// Every grid of a NanoVDB file, converted to an OpenVDB grid with its tree
+// (nanovdb::nanoToOpenVDB; a quantised Fp4/8/16/N grid becomes a float grid
+// of its decoded values), named and classed as in the file. A grid of a
+// type the converter does not know (points, indices) is left out. The
+// grids are complete: the callers treat them as read.
+openvdb::GridPtrVec read_nanovdb(const std::string& path)
+{
+    init_openvdb();
+    check_readable(path);
+    std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> handles;
+    try {
+        handles = nanovdb::io::readGrids(path);
+    } catch (const std::exception& e) {
+        fail_with(VEIL_ERR_IO, path + ": cannot read the NanoVDB file: " + e.what());
+    }
+    if (handles.empty()) fail_with(VEIL_ERR_IO, path + ": cannot read the NanoVDB file: it holds no grid");
+    openvdb::GridPtrVec out;
+    for (const auto& h : handles) {
+        const nanovdb::GridMetaData* m = h.gridMetaData();
+        if (!m) continue;
+        GridBase::Ptr g;
+        try {
+            g = nanovdb::nanoToOpenVDB(h);
+        } catch (const openvdb::RuntimeError&) {
+            continue; // a type with no OpenVDB counterpart
+        }
+        if (!g) continue;
+        g->setName(m->shortGridName());
+        if (m->isLevelSet()) g->setGridClass(openvdb::GRID_LEVEL_SET);
+        else if (m->isFogVolume()) g->setGridClass(openvdb::GRID_FOG_VOLUME);
+        out.push_back(g);
+    }
+    return out;
+}
+
 // The grid to load: the named one, or the default (see vdb.h).
 GridBase::Ptr choose(const std::string& path, const openvdb::GridPtrVec& grids, const char* want)
 {
@@ -188,7 +235,7 @@ char* dup_c(const std::string& s)
     return p;
 }
 
-void fill_info(openvdb::io::File& file, const GridBase& meta, veil_vdb_grid_info& gi)
+void fill_info(openvdb::io::File* file, const GridBase& meta, veil_vdb_grid_info& gi)
 {
     gi.name = dup_c(meta.getName());
     copy_name(class_name(meta), gi.grid_class, sizeof gi.grid_class);
@@ -201,11 +248,14 @@ void fill_info(openvdb::io::File& file, const GridBase& meta, veil_vdb_grid_info
     const auto bmin = meta.getMetadata<openvdb::Vec3IMetadata>(GridBase::META_FILE_BBOX_MIN);
     const auto bmax = meta.getMetadata<openvdb::Vec3IMetadata>(GridBase::META_FILE_BBOX_MAX);
     const auto cnt = meta.getMetadata<openvdb::Int64Metadata>(GridBase::META_FILE_VOXEL_COUNT);
-    if (bmin && bmax && cnt) {
+    if (!file) { // a grid read whole (NanoVDB): its tree is here
+        count = meta.activeVoxelCount();
+        box = meta.evalActiveVoxelBoundingBox();
+    } else if (bmin && bmax && cnt) {
         count = (openvdb::Index64)cnt->value();
         box = CoordBBox(Coord(bmin->value()), Coord(bmax->value()));
     } else { // written without statistics: read the tree
-        GridBase::Ptr g = file.readGrid(meta.getName());
+        GridBase::Ptr g = file->readGrid(meta.getName());
         count = g->activeVoxelCount();
         box = g->evalActiveVoxelBoundingBox();
     }
@@ -278,9 +328,15 @@ veil_result veil_vdb_open(const char* path, const char* grid_name, int level_set
     if (!path || !out) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_open: path and out are required");
     veil_vdb* v = nullptr;
     veil_result r = guarded(err, path, [&] {
+        const bool nano = is_nanovdb(path);
         openvdb::io::File file(path);
-        open_file(file, path);
-        openvdb::GridPtrVec metas = *file.readAllGridMetadata();
+        openvdb::GridPtrVec metas;
+        if (nano) {
+            metas = read_nanovdb(path);
+        } else {
+            open_file(file, path);
+            metas = *file.readAllGridMetadata();
+        }
         GridBase::Ptr meta = choose(path, metas, grid_name);
         const std::string name = meta->getName(), where = std::string(path) + ": grid " + quoted(name);
         if (!meta->isType<FloatGrid>())
@@ -291,8 +347,8 @@ veil_result veil_vdb_open(const char* path, const char* grid_name, int level_set
                       where + " is a level set (a signed distance to a surface, not a density); add \"level_set\": "
                               "\"to_fog\" to the vdb source to convert it into a fog volume when it is read, or "
                               "convert the file with vdb_tool -ls2fog");
-        FloatGrid::Ptr grid = openvdb::gridPtrCast<FloatGrid>(file.readGrid(name));
-        file.close();
+        FloatGrid::Ptr grid = openvdb::gridPtrCast<FloatGrid>(nano ? meta : file.readGrid(name));
+        if (!nano) file.close();
         if (!grid) fail_with(VEIL_ERR_IO, where + ": OpenVDB returned no float grid");
         if (grid->getGridClass() == openvdb::GRID_LEVEL_SET) openvdb::tools::sdfToFogVolume(*grid);
         zero_inactive(*grid);
@@ -378,13 +434,19 @@ veil_result veil_vdb_file_info(const char* path, veil_vdb_grid_info** grids, siz
     veil_vdb_grid_info* out = nullptr;
     size_t n = 0;
     veil_result r = guarded(err, path, [&] {
+        const bool nano = is_nanovdb(path);
         openvdb::io::File file(path);
-        open_file(file, path);
-        openvdb::GridPtrVec metas = *file.readAllGridMetadata();
+        openvdb::GridPtrVec metas;
+        if (nano) {
+            metas = read_nanovdb(path);
+        } else {
+            open_file(file, path);
+            metas = *file.readAllGridMetadata();
+        }
         out = static_cast<veil_vdb_grid_info*>(std::calloc(metas.size() ? metas.size() : 1, sizeof *out));
         if (!out) throw std::bad_alloc();
-        for (const auto& m : metas) fill_info(file, *m, out[n++]);
-        file.close();
+        for (const auto& m : metas) fill_info(nano ? nullptr : &file, *m, out[n++]);
+        if (!nano) file.close();
     });
     if (r != VEIL_OK) {
         veil_vdb_file_info_free(out, n);

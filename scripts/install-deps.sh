@@ -10,6 +10,7 @@ packages=(
   libepoxy-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri   # EGL + GL 4.5 (llvmpipe)
   libcglm-dev libopenexr-dev libpng-dev libcjson-dev
   g++ libopenvdb-dev libboost-dev libtbb-dev                     # the OpenVDB reader (io/vdb.cpp)
+  libnanovdb-dev                                                 # .nvdb files (headers only, io/vdb.cpp)
 )
 
 missing=()

@@ -13,6 +13,7 @@
 //   empty.vdb            "density": a float grid with no active voxel
 //   offset_scaled.vdb    "density": voxel 0.25 m, translated by (1, -2, 3); the linear field
 //                        1 + i/2 + j/4 + k/8 on the index block [0, 15]^3 (pins the convention)
+//   offset_scaled.nvdb   the same grid written by NanoVDB (io/vdb.cpp reads .nvdb too)
 //   rotated.vdb          "density": a Gaussian blob under scale + rotation + translation
 //   frustum.vdb          "density": a frustum (non-affine) transform
 //   far_apart.vdb        "density": two voxels at index (0,0,0) and (1100,1100,1100)
@@ -27,6 +28,8 @@
 #include <openvdb/io/File.h>
 #include <openvdb/tools/LevelSetSphere.h>
 #include <openvdb/tools/LevelSetUtil.h>
+#include <nanovdb/util/IO.h>
+#include <nanovdb/util/OpenToNanoVDB.h>
 
 #include <cmath>
 #include <cstdint>
@@ -164,6 +167,8 @@ void make_all(bool big)
                 for (int i = 0; i < 16; ++i) acc.setValue(Coord(i, j, k), 1.0f + i / 2.0f + j / 4.0f + k / 8.0f);
     }
     write("offset_scaled.vdb", {lin});
+    // the same grid as NanoVDB (pbrt-v4's scenes ship .nvdb): readers must see the same values
+    nanovdb::io::writeGrid(path("offset_scaled.nvdb"), nanovdb::openToNanoVDB(*lin));
 
     // A Gaussian blob (sigma 5 voxels, cut at 4 sigma) under voxel 0.05 m,
     // rotated 30 deg about z then 20 deg about x, then moved to (0.5, 0.25, -1).

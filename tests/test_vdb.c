@@ -5,7 +5,7 @@
  *
  * One ctest per CASE (tests/vdb_tests.cmake): open, select, level_set,
  * types, bad_files, empty, transform, threads, fast_path, mass, rotated,
- * limits, scene_volume, native.
+ * limits, scene_volume, native, nanovdb.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
@@ -744,6 +744,63 @@ static void test_native(void)
     veil_scene_free(&s);
 }
 
+/* A NanoVDB file is read like an OpenVDB file: offset_scaled.nvdb holds
+ * the same grid as offset_scaled.vdb (make_test_vdbs writes both), so the
+ * reader must give the same name, index box, active count, transform and
+ * values, bit for bit (a float NanoVDB grid stores the floats as they are). */
+static void test_nanovdb(void)
+{
+    char a[4200], b[4200];
+    snprintf(a, sizeof a, "%s/offset_scaled.vdb", g_dir);
+    snprintf(b, sizeof b, "%s/offset_scaled.nvdb", g_dir);
+    veil_vdb *va = NULL, *vb = NULL;
+    veil_error err = {0};
+    char name[64] = "";
+    CHECK(veil_vdb_open(a, NULL, 0, &va, NULL, 0, &err) == VEIL_OK, "%s", err.msg);
+    CHECK(veil_vdb_open(b, NULL, 0, &vb, name, sizeof name, &err) == VEIL_OK, "%s", err.msg);
+    if (!va || !vb) {
+        veil_vdb_close(va);
+        veil_vdb_close(vb);
+        return;
+    }
+    CHECK(strcmp(name, "density") == 0, "the .nvdb grid's name: '%s'", name);
+    int alo[3], ahi[3], blo[3], bhi[3];
+    size_t an = 0, bn = 0;
+    veil_vdb_index_bbox(va, alo, ahi, &an);
+    veil_vdb_index_bbox(vb, blo, bhi, &bn);
+    CHECK(an == bn && memcmp(alo, blo, sizeof alo) == 0 && memcmp(ahi, bhi, sizeof ahi) == 0,
+          "index box and count: %zu vs %zu", an, bn);
+    double ma[4][4], mb[4][4];
+    CHECK(veil_vdb_transform(va, ma, &err) == VEIL_OK && veil_vdb_transform(vb, mb, &err) == VEIL_OK, "%s", err.msg);
+    CHECK(memcmp(ma, mb, sizeof ma) == 0, "transform differs");
+    float da[16 * 16 * 16], db[16 * 16 * 16];
+    CHECK(veil_vdb_dense(va, alo, ahi, da) == VEIL_OK && veil_vdb_dense(vb, alo, ahi, db) == VEIL_OK, "dense reads");
+    CHECK(memcmp(da, db, sizeof da) == 0, "values differ");
+    veil_vdb_grid_info* info = NULL;
+    size_t count = 0;
+    CHECK(veil_vdb_file_info(b, &info, &count, &err) == VEIL_OK && count == 1 && info &&
+              strcmp(info[0].name, "density") == 0 && info[0].active_voxels == 4096 &&
+              strcmp(info[0].grid_class, "fog volume") == 0,
+          "file info of the .nvdb: %s", err.msg);
+    veil_vdb_file_info_free(info, count);
+    veil_vdb_close(va);
+    veil_vdb_close(vb);
+    /* a corrupt .nvdb: an I/O error naming it */
+    char c[4200];
+    snprintf(c, sizeof c, "%s/garbage.nvdb", g_dir);
+    FILE* f = fopen(c, "wb");
+    if (f) {
+        fputs("not a NanoVDB file at all\n", f);
+        fclose(f);
+    }
+    veil_vdb* vc = NULL;
+    veil_result r = veil_vdb_open(c, NULL, 0, &vc, NULL, 0, &err);
+    CHECK(r == VEIL_ERR_IO && strstr(err.msg, "garbage.nvdb") && strstr(err.msg, "NanoVDB"), "corrupt .nvdb: %s: %s",
+          veil_result_name(r), err.msg);
+    veil_vdb_close(vc);
+    remove(c);
+}
+
 int main(int argc, char** argv)
 {
     if (argc != 3) {
@@ -758,7 +815,7 @@ int main(int argc, char** argv)
                  {"types", test_types},     {"bad_files", test_bad_files}, {"empty", test_empty},
                  {"transform", test_transform}, {"threads", test_threads}, {"fast_path", test_fast_path},
                  {"mass", test_mass},       {"rotated", test_rotated},     {"limits", test_limits},
-                 {"scene_volume", test_scene_volume}, {"native", test_native}};
+                 {"scene_volume", test_scene_volume}, {"native", test_native}, {"nanovdb", test_nanovdb}};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i)
         if (strcmp(argv[2], cases[i].name) == 0) {
             cases[i].fn();

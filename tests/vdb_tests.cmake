@@ -40,6 +40,8 @@ veil_vdb_case(limits unit)
 veil_vdb_case(scene_volume unit)
 # native resolution: a VDB without max_resolution keeps its voxels (values copied)
 veil_vdb_case(native "unit;accuracy")
+# NanoVDB (.nvdb) files read like OpenVDB files, by the reader and `veil info`
+veil_vdb_case(nanovdb unit)
 
 # `veil info` (tests/vdb_bad.sh VEIL EXPECTED_EXIT EXPECTED_TEXT ARGS...).
 function(veil_vdb_cli name rc text)
@@ -51,6 +53,7 @@ veil_vdb_cli(info_table 0 "density" info ${VDB_DATA}/offset_scaled.vdb)
 veil_vdb_cli(info_table_count 0 "4096" info ${VDB_DATA}/offset_scaled.vdb)
 # what render will do with a grid: copy it (axis-aligned cubes) or resample it (rotated)
 veil_vdb_cli(info_native 0 "rendering native: axis-aligned 0.25 m cubes, values copied" info ${VDB_DATA}/offset_scaled.vdb)
+veil_vdb_cli(info_nanovdb 0 "density fog volume float 4096 0.25" info ${VDB_DATA}/offset_scaled.nvdb)
 veil_vdb_cli(info_rotated 0 "rendering resampled at its smallest voxel edge" info ${VDB_DATA}/rotated.vdb)
 veil_vdb_cli(info_json 0 "\"name\": \"temperature\"" info ${VDB_DATA}/two_grids.vdb --json)
 veil_vdb_cli(info_json_count 0 "\"active_voxels\": 5," info ${VDB_DATA}/two_grids.vdb --json)
