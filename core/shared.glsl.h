@@ -112,6 +112,7 @@
 #define VEIL_TEX_OCC 5          /* texture unit: occupancy bricks (max density per brick) */
 #define VEIL_TEX_LIMIT 6        /* texture unit: r32f per-pixel distance where the ray ends (veil fog) */
 #define VEIL_TEX_DIFFUSION 7    /* texture unit: rgba32f multiply scattered fluence (render/diffusion.h) */
+#define VEIL_TEX_EMISSION 8     /* texture unit: rgba32f emission eps (W m^-3 sr^-1) on the EV's grid */
 
 /* A light as the GPU sees it: one shape for every shader (std140, 48 bytes).
  * Filled from scene/scene.h's veil_light by veil_gpu_light_from(). */
@@ -144,7 +145,7 @@ VEIL_STRUCT_BEGIN(veil_march_block)
     VEIL_V4(sigma_s);      /* rgb: m^-1 per unit density */
     VEIL_V4(background);   /* rgb: radiance behind the medium */
     VEIL_V4(march);        /* x: step (m), y: floor on |S - X|^2 (m^2), z: voxel (m), w: HG g */
-    VEIL_V4(limits);       /* x: no step starts at or beyond this distance (m; 3e38: no limit) */
+    VEIL_V4(limits);       /* x: no step starts at or beyond this distance (m; 3e38: no limit); y: 1 with emission */
     VEIL_IV4(size);        /* x, y: image size (pixels); z: lights; w: fogs */
     VEIL_UV4(flags);       /* x: has a volume, y: skip empty bricks, z: jitter seed, w: per-pixel end */
     VEIL_V4(octave);       /* volumetric multiple scattering: x: a, y: b, z: c, w: octaves (0: off) */

@@ -357,7 +357,8 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
     for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) opv[t] = veil_opv_set_texture(r->opv, t);
     veil_march_desc md = {.scene = s, .camera = o->camera, .width = o->width, .height = o->height,
                           .lights = lights, .light_count = n, .grid = g,
-                          .ev = veil_ev_texture(r->ev), .occupancy = veil_ev_occupancy(r->ev), .opv = opv,
+                          .ev = veil_ev_texture(r->ev), .occupancy = veil_ev_occupancy(r->ev),
+                          .emission = veil_ev_emission(r->ev), .opv = opv,
                           .step_voxels = o->step_voxels, .seed = o->seed, .skip_empty = !o->no_skip,
                           .max_distance = o->max_distance, .end_distance = o->behind_distance,
                           .no_background = o->behind != NULL};

@@ -12,7 +12,8 @@
 #include <string.h>
 
 static const char* const SOURCE_TYPES[] = {"rbf", "rbf_random", "vdb", "exponential", NULL}; /* = veil_source_type */
-static const char* const VDB_KEYS[] = {"type", "file", "grid", "density_scale", "level_set", NULL};
+static const char* const VDB_KEYS[] = {"type", "file", "grid", "density_scale", "level_set", "emission", NULL};
+static const char* const EMISSION_KEYS[] = {"grid", "scale", "color", NULL};
 static const char* const FOG_KEYS[] = {"type", "density", "falloff", "direction", "origin", "bounds", NULL};
 static const char* const RBF_KEYS[] = {"type", "particles", "file", NULL};
 static const char* const RANDOM_KEYS[] = {"type", "count", "seed", "bounds", "radius", "amplitude", NULL};
@@ -142,7 +143,18 @@ static veil_result parse_vdb(const ctx* c, const cJSON* so, const jpath* sp, vei
     }
     v->level_set_to_fog = ls != NULL;
     free(ls);
-    return VEIL_OK;
+    /* "emission": {"grid": name (required), "scale": >= 0 (1), "color": [3] >= 0 ([1, 1, 1])} */
+    const jpath ep = {sp, "emission", 0};
+    const cJSON* eo;
+    TRY(veil__jr_get_container(c, so, &ep, false, false, &eo));
+    if (!eo) return VEIL_OK;
+    TRY(veil__jr_check_keys(c, eo, &ep, EMISSION_KEYS));
+    TRY(get_string(c, eo, &ep, "grid", true, &v->emission_grid));
+    double es = 1.0;
+    TRY(veil__jr_get_number(c, eo, &ep, "scale", false, &VEIL__R_NONNEG, &es));
+    v->emission_scale = (float)es;
+    v->emission_color[0] = v->emission_color[1] = v->emission_color[2] = 1.0f;
+    return veil__jr_get_floats(c, eo, &ep, "color", false, 3, true, v->emission_color);
 }
 
 static veil_result parse_fog(const ctx* c, const cJSON* so, const jpath* sp, veil_exp_fog* f)

@@ -297,6 +297,12 @@ static void trace(const pt_job* j, const double o[3], const double d[3], pt_rng*
         memcpy(beta0, beta, sizeof beta0);
         pt_segment sg;
         segment_init(j, pos, dir, &sg);
+        /* emission along this segment reaches the vertex after `depth` scatterings */
+        if (m->emission[0] && (max_order == 0 || depth <= max_order)) {
+            double e[3];
+            veil__pt_emission(m, pos, dir, e);
+            for (int k = 0; k < 3; ++k) L[k] += beta0[k] * e[k];
+        }
         /* (e) whatever the walk does next on this segment: it is a second,
          * independent estimate of the same integral */
         if (sg.any) equiangular_light(j, &sg, pos, dir, beta0, rng, L, c);
@@ -451,8 +457,9 @@ veil_result veil_pt_render(const veil_pt_medium* m, const veil_scene* s, const v
     j->o = opts;
     j->g = s->medium.phase.type == VEIL_PHASE_HG ? s->medium.phase.g : 0.0;
     j->mis = sampling == VEIL_PT_LIGHT_SAMPLING_MIS;
-    j->may_vary = opts->environment || opts->stochastic_background;
-    j->needs_collision = !opts->stochastic_background;
+    /* emission: scattered emission varies, and direct emission needs no collision */
+    j->may_vary = opts->environment || opts->stochastic_background || m->emission[0] != NULL;
+    j->needs_collision = !opts->stochastic_background && m->emission[0] == NULL;
     for (size_t l = 0; l < s->light_count; ++l) {
         j->may_vary |= !is_dark(&s->lights[l]);
         /* an equiangular sample lights a sample without any collision */

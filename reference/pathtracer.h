@@ -81,6 +81,12 @@
  *    strategies. At all orders in dense media around a light that term
  *    dominates (docs/accuracy.md has numbers); sampling directions towards
  *    the light as well would be the next step.
+ *  - Emission (a vdb source's "emission" grid): on every segment of the
+ *    path (the camera ray and each ray leaving a scattering vertex) the
+ *    emitted radiance integrated along it, int T eps dt, deterministic
+ *    (veil__pt_emission: exact T, eps trilinear at quarter-voxel steps), times
+ *    the throughput; it counts when it reaches the camera after at most
+ *    max_order scatterings (direct emission is order 0).
  *  - Continuation: the phase function sampled exactly (weight 1).
  *  - Path length: absorption is sampled as an event (the path ends with
  *    probability P_absorb: Russian roulette on absorption), and from the

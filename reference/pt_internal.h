@@ -29,6 +29,7 @@ struct veil_pt_medium {
     pt_fog fog[VEIL_MAX_FOGS];
     double sigma_a[3], sigma_s[3], sigma_t[3];
     double sigma_max;      /* largest sigma_t channel (m^-1 per unit density) */
+    float* emission[3];    /* NULL, or per channel the emission eps on `grid` (W m^-3 sr^-1, owned) */
 };
 
 /* A per-pixel random stream (core/rng.h). */
@@ -89,6 +90,13 @@ double veil__pt_scatter_pdf(const veil_pt_medium* m, const double o[3], const do
  * crossings), and each piece, inside one cell whose 8 values are read
  * once, is integrated by 2-point Gauss-Legendre (exact for cubics). */
 double veil__pt_grid_depth(const veil_pt_medium* m, const double o[3], const double d[3], double t0, double t1);
+
+/* The emitted radiance reaching o along -d: int T(0, t) eps(t) dt over the
+ * grid's box, per channel, eps trilinear and T exact; per step of a quarter
+ * voxel eps is taken at the midpoint and T integrated in closed form,
+ * T(t_k) eps h (1 - exp(-x)) / x with x the step's optical thickness (exact
+ * for a homogeneous medium). 0 without emission. */
+void veil__pt_emission(const veil_pt_medium* m, const double o[3], const double d[3], double out[3]);
 
 /* Slab test of o + t d against [lo, hi] for t in [t0, t1]: 1 and the
  * clipped range when they overlap in a segment of positive length. */

@@ -159,10 +159,28 @@ veil_result veil_pt_medium_from_scene(const veil_scene* s, veil_pt_medium** out,
     veil_scene_volume v;
     veil_result r = veil_scene_volume_open(s, &v, err);
     if (r != VEIL_OK) return r;
-    float* density = NULL;
+    float *density = NULL, *emission = NULL;
     if (v.has_volume) r = veil_scene_volume_density(&v, &density, err);
+    if (r == VEIL_OK) r = veil_scene_volume_emission(&v, &emission, err);
     if (r == VEIL_OK) r = veil_pt_medium_from_density(s, v.has_volume ? &v.grid : NULL, density, out, err);
+    if (r == VEIL_OK && emission && (*out)->has_grid) {
+        size_t n = veil_grid_voxels(&v.grid);
+        for (int c = 0; c < 3 && r == VEIL_OK; ++c) {
+            float* plane = malloc(n * sizeof *plane);
+            if (!plane) {
+                r = veil_fail(err, VEIL_ERR_OOM, "out of memory for the emission");
+                break;
+            }
+            for (size_t k = 0; k < n; ++k) plane[k] = emission[4 * k + (size_t)c];
+            (*out)->emission[c] = plane;
+        }
+        if (r != VEIL_OK) {
+            veil_pt_medium_free(*out);
+            *out = NULL;
+        }
+    }
     free(density);
+    free(emission);
     veil_scene_volume_close(&v);
     return r;
 }
@@ -170,6 +188,7 @@ veil_result veil_pt_medium_from_scene(const veil_scene* s, veil_pt_medium** out,
 void veil_pt_medium_free(veil_pt_medium* m)
 {
     if (!m) return;
+    for (int c = 0; c < 3; ++c) free(m->emission[c]);
     free(m->rho);
     free(m->major);
     free(m);
@@ -539,3 +558,31 @@ double veil__pt_scatter_pdf(const veil_pt_medium* m, const double o[3], const do
     return den > 0.0 ? rho * num / den : 0.0;
 }
 
+
+void veil__pt_emission(const veil_pt_medium* m, const double o[3], const double d[3], double out[3])
+{
+    out[0] = out[1] = out[2] = 0.0;
+    double a, b;
+    if (!m->emission[0] || !m->has_grid || !veil__pt_box_clip(m->box_lo, m->box_hi, o, d, 0.0, INFINITY, &a, &b))
+        return;
+    const double h = 0.25 * m->grid.voxel;
+    /* the optical depth from o to a: the fogs and the grid (0 before the box) */
+    double D = fog_depth(m, o, d, a);
+    for (double t = a; t < b;) {
+        double te = fmin(t + h, b), p[3], q[3];
+        for (int k = 0; k < 3; ++k) {
+            p[k] = o[k] + t * d[k];
+            q[k] = o[k] + 0.5 * (t + te) * d[k];
+        }
+        double Dstep = veil__pt_grid_depth(m, o, d, t, te) + fog_depth(m, p, d, te - t);
+        for (int c = 0; c < 3; ++c) {
+            double eps = veil_ev_sample(&m->grid, m->emission[c], q);
+            if (!(eps > 0.0)) continue;
+            double x = m->sigma_t[c] * Dstep;
+            double frac = x < 1e-6 ? 1.0 - 0.5 * x : -expm1(-x) / x;
+            out[c] += exp(-m->sigma_t[c] * D) * eps * (te - t) * frac;
+        }
+        D += Dstep;
+        t = te;
+    }
+}

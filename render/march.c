@@ -96,7 +96,9 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
     for (int l = 0; l < n; ++l) veil_gpu_light_from(&d->lights[l], &u->lights[l]);
     u->size[0] = d->width, u->size[1] = d->height, u->size[2] = n, u->size[3] = fogs;
     u->flags[0] = d->grid != NULL;
-    u->flags[1] = d->grid != NULL && fogs == 0 && d->skip_empty;
+    /* empty bricks hold no density but may glow: no skipping with emission */
+    u->flags[1] = d->grid != NULL && fogs == 0 && d->skip_empty && !d->emission;
+    u->limits[1] = d->grid != NULL && d->emission ? 1.0f : 0.0f;
     u->flags[2] = d->seed;
     u->flags[3] = d->end_distance != NULL;
     const veil_multiple* ms = &d->scene->multiple;
@@ -158,11 +160,12 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, d->opv ? d->opv[t] : 0);
         glBindTextureUnit(VEIL_TEX_LIMIT, limit);
         glBindTextureUnit(VEIL_TEX_DIFFUSION, d->diffusion ? d->diffusion->texture : 0);
+        glBindTextureUnit(VEIL_TEX_EMISSION, d->grid ? d->emission : 0);
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], tex[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glDispatchCompute(veil_groups(w, VEIL_MARCH_GROUP), veil_groups(h, VEIL_MARCH_GROUP), 1);
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        for (int t = 0; t <= VEIL_TEX_DIFFUSION; ++t) glBindTextureUnit((GLuint)t, 0);
+        for (int t = 0; t <= VEIL_TEX_EMISSION; ++t) glBindTextureUnit((GLuint)t, 0);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, 0);
         glUseProgram(0);
         r = veil_gl_check("ray march (render/shaders/march.comp)", err);

@@ -47,6 +47,7 @@ typedef struct veil_march_desc {
     int light_count;
     const veil_grid* grid;     /* NULL: no volume (fog only) */
     GLuint ev, occupancy;      /* the EV's textures when grid is set */
+    GLuint emission;           /* the EV's emission texture (0: none) */
     const GLuint* opv;         /* VEIL_MAX_OPV_TEXTURES textures (0 where unused) */
     float step_voxels;         /* > 0 */
     uint32_t seed;             /* jitter seed */

@@ -11,6 +11,7 @@ void veil_scene_free(veil_scene* s)
         free(s->medium.sources[i].particles);
         free(s->medium.sources[i].vdb.file);
         free(s->medium.sources[i].vdb.grid);
+        free(s->medium.sources[i].vdb.emission_grid);
     }
     free(s->medium.sources);
     free(s->lights);

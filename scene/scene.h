@@ -53,6 +53,13 @@ typedef struct veil_vdb_source {
     char* grid;          /* grid name, or NULL: "density", else the first float grid (owned) */
     float density_scale; /* multiplies the grid's values; default 1 */
     int level_set_to_fog; /* "level_set": "to_fog": convert a level set instead of refusing it */
+    /* "emission": {"grid", "scale", "color"}: the medium emits radiance
+     * eps = scale * value * color per metre of path (W m^-3 sr^-1, i.e.
+     * W/(m^2 sr) of radiance added per m), from the named float grid of
+     * the same file; NULL grid: no emission */
+    char* emission_grid; /* owned */
+    float emission_scale;
+    float emission_color[3];
 } veil_vdb_source;
 
 /* Analytic exponential (height) fog ({"type":"exponential", ...}):

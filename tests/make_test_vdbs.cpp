@@ -14,6 +14,7 @@
 //   offset_scaled.vdb    "density": voxel 0.25 m, translated by (1, -2, 3); the linear field
 //                        1 + i/2 + j/4 + k/8 on the index block [0, 15]^3 (pins the convention)
 //   offset_scaled.nvdb   the same grid written by NanoVDB (io/vdb.cpp reads .nvdb too)
+//   emissive_slab.vdb    "density" and "heat" 1 on [0,19]x[0,19]x[0,9], voxel 0.1 m
 //   rotated.vdb          "density": a Gaussian blob under scale + rotation + translation
 //   frustum.vdb          "density": a frustum (non-affine) transform
 //   far_apart.vdb        "density": two voxels at index (0,0,0) and (1100,1100,1100)
@@ -167,6 +168,17 @@ void make_all(bool big)
                 for (int i = 0; i < 16; ++i) acc.setValue(Coord(i, j, k), 1.0f + i / 2.0f + j / 4.0f + k / 8.0f);
     }
     write("offset_scaled.vdb", {lin});
+
+    // An emissive slab: "density" and "heat" both 1 on the index box
+    // [0, 19] x [0, 19] x [0, 9], voxel 0.1 m (tests/test_emission.c)
+    FloatGrid::Ptr slab = float_grid("density", 0.1), heat = float_grid("heat", 0.1);
+    {
+        FloatGrid::Accessor a = slab->getAccessor(), b = heat->getAccessor();
+        for (int k = 0; k < 10; ++k)
+            for (int j = 0; j < 20; ++j)
+                for (int i = 0; i < 20; ++i) a.setValue(Coord(i, j, k), 1.0f), b.setValue(Coord(i, j, k), 1.0f);
+    }
+    write("emissive_slab.vdb", {slab, heat});
     // the same grid as NanoVDB (pbrt-v4's scenes ship .nvdb): readers must see the same values
     nanovdb::io::writeGrid(path("offset_scaled.nvdb"), nanovdb::openToNanoVDB(*lin));
 

@@ -61,3 +61,10 @@ veil_vdb_cli(info_garbage 1 "garbage.vdb: cannot read the OpenVDB file" info ${V
 veil_vdb_cli(info_missing 1 "does_not_exist.vdb: cannot open: No such file or directory"
              info ${VDB_DATA}/does_not_exist.vdb)
 veil_vdb_cli(info_usage 2 "info: missing FILE.vdb" info)
+
+# Emission (a vdb source's "emission" grid): march and reference against the
+# closed form of an emissive absorbing slab.
+add_executable(test_emission ${CMAKE_CURRENT_SOURCE_DIR}/test_emission.c ${CMAKE_CURRENT_SOURCE_DIR}/check.c)
+target_link_libraries(test_emission PRIVATE veil veil_fp veil_warnings)
+add_test(NAME test_emission COMMAND test_emission ${VDB_DATA})
+set_tests_properties(test_emission PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "gpu;accuracy" SKIP_RETURN_CODE 77)

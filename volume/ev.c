@@ -10,6 +10,7 @@
 struct veil_ev {
     GLuint inject, occupancy; /* programs */
     GLuint tex, occ;          /* the volume and its occupancy bricks */
+    GLuint emission;          /* rgba32f emission (0: none) */
     int present;
     veil_grid grid;
 };
@@ -33,7 +34,8 @@ void veil_ev_clear(veil_ev* ev)
 {
     glDeleteTextures(1, &ev->tex);
     glDeleteTextures(1, &ev->occ);
-    ev->tex = ev->occ = 0;
+    glDeleteTextures(1, &ev->emission);
+    ev->tex = ev->occ = ev->emission = 0;
     ev->present = 0;
 }
 
@@ -49,6 +51,8 @@ void veil_ev_destroy(veil_ev* ev)
 int veil_ev_present(const veil_ev* ev) { return ev->present; }
 const veil_grid* veil_ev_grid(const veil_ev* ev) { return ev->present ? &ev->grid : NULL; }
 GLuint veil_ev_texture(const veil_ev* ev) { return ev->tex; }
+GLuint veil_ev_emission(const veil_ev* ev) { return ev->present ? ev->emission : 0; }
+
 GLuint veil_ev_occupancy(const veil_ev* ev) { return ev->occ; }
 
 veil_result veil_ev_check_budget(const veil_grid* g, int n_lights, unsigned long long budget, veil_error* err)
@@ -134,6 +138,17 @@ veil_result veil_ev_build_scene(veil_ev* ev, const veil_scene_volume* v, int n_l
     if (r == VEIL_OK && n > 0) r = veil_rbf_bin(g, v->particles, n, &bins, err);
     if (r == VEIL_OK && n > 0) r = veil_inject_rbf_gpu(ev->inject, g, &bins, ev->tex, err);
     if (r == VEIL_OK) r = build_occupancy(ev, err);
+    float* emission = NULL;
+    if (r == VEIL_OK) r = veil_scene_volume_emission(v, &emission, err);
+    if (r == VEIL_OK && emission) {
+        r = veil_gl_texture3d(GL_RGBA32F, g->dims, "veil emission", &ev->emission, err);
+        if (r == VEIL_OK) {
+            glTextureSubImage3D(ev->emission, 0, 0, 0, 0, g->dims[0], g->dims[1], g->dims[2], GL_RGBA, GL_FLOAT,
+                                emission);
+            r = veil_gl_check("uploading the emission", err);
+        }
+    }
+    free(emission);
     if (r != VEIL_OK) veil_ev_clear(ev);
     free(density);
     veil_rbf_bins_free(&bins);

@@ -38,6 +38,9 @@ int veil_ev_present(const veil_ev* ev);
 const veil_grid* veil_ev_grid(const veil_ev* ev);
 GLuint veil_ev_texture(const veil_ev* ev);
 GLuint veil_ev_occupancy(const veil_ev* ev);
+/* The emission (rgba32f, eps per channel, W m^-3 sr^-1) of the scene's vdb
+ * sources' "emission" grids on the same grid; 0 when there is none. */
+GLuint veil_ev_emission(const veil_ev* ev);
 
 /* The GPU bytes of an EV of grid g plus the optical-depth textures of
  * n_lights lights (and their scratch texture), refused with the numbers

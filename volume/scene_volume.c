@@ -14,6 +14,7 @@ void veil_scene_volume_close(veil_scene_volume* v)
 {
     if (!v) return;
     for (int i = 0; i < v->vdb_count; ++i) veil_vdb_close(v->vdbs[i]);
+    for (int i = 0; i < v->emission_count; ++i) veil_vdb_close(v->emission[i]);
     free(v->particles);
     memset(v, 0, sizeof *v);
 }
@@ -51,7 +52,45 @@ static veil_result open_vdb(veil_scene_volume* v, const veil_source* src, size_t
         if (r == VEIL_OK) grow(lo, hi, any, a, b);
     }
     v->vdb_voxels += active;
+    if (r != VEIL_OK || !src->vdb.emission_grid) return r;
+    /* the emission grid of the same file */
+    veil_vdb* e = NULL;
+    r = veil_vdb_open(src->vdb.file, src->vdb.emission_grid, 0, &e, NULL, 0, &inner);
+    if (r != VEIL_OK) return veil_fail(err, r, "medium.sources[%zu].emission.grid: %.1900s", i, inner.msg);
+    v->emission[v->emission_count] = e;
+    for (int c = 0; c < 3; ++c)
+        v->emission_factor[v->emission_count][c] = src->vdb.emission_scale * src->vdb.emission_color[c];
+    v->emission_count++;
+    r = veil_vdb_index_bbox(e, ilo, ihi, &active);
+    if (r == VEIL_OK && active > 0) {
+        float a[3], b[3];
+        r = veil_vdb_world_support(e, a, b, err);
+        if (r == VEIL_OK) grow(lo, hi, any, a, b);
+    }
     return r;
+}
+
+veil_result veil_scene_volume_emission(const veil_scene_volume* v, float** rgba, veil_error* err)
+{
+    *rgba = NULL;
+    if (!v->has_volume || v->emission_count == 0) return VEIL_OK;
+    size_t n = veil_grid_voxels(&v->grid);
+    float* out = calloc(n * 4, sizeof *out);
+    float* one = malloc(n * sizeof *one);
+    veil_result r = out && one ? VEIL_OK : veil_fail(err, VEIL_ERR_OOM, "out of memory for a %zu-voxel emission", n);
+    for (int i = 0; i < v->emission_count && r == VEIL_OK; ++i) {
+        memset(one, 0, n * sizeof *one);
+        r = veil_vdb_to_grid(v->emission[i], 1.0f, &v->grid, one, err);
+        for (size_t k = 0; k < n && r == VEIL_OK; ++k)
+            for (int c = 0; c < 3; ++c) out[4 * k + (size_t)c] += v->emission_factor[i][c] * one[k];
+    }
+    free(one);
+    if (r != VEIL_OK) {
+        free(out);
+        return r;
+    }
+    *rgba = out;
+    return VEIL_OK;
 }
 
 /* A file's identity: its path, size, modification time and inode, not
@@ -95,6 +134,10 @@ uint64_t veil_scene_volume_key(const veil_scene* s)
             k = veil_hash_bytes(k, grid, strlen(grid) + 1);
             k = veil_hash_bytes(k, &src->vdb.density_scale, sizeof src->vdb.density_scale);
             k = veil_hash_bytes(k, &src->vdb.level_set_to_fog, sizeof src->vdb.level_set_to_fog);
+            const char* eg = src->vdb.emission_grid ? src->vdb.emission_grid : "";
+            k = veil_hash_bytes(k, eg, strlen(eg) + 1);
+            k = veil_hash_bytes(k, &src->vdb.emission_scale, sizeof src->vdb.emission_scale);
+            k = veil_hash_bytes(k, src->vdb.emission_color, sizeof src->vdb.emission_color);
         }
     }
     return k;

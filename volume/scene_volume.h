@@ -38,7 +38,18 @@ typedef struct veil_scene_volume {
     veil_grid grid;
     /* How the grid was chosen, for --stats: "native: ..." or "resampled: ..." */
     char resolution[192];
+    /* Emission grids ("emission" of a vdb source, owned) and their factor
+     * scale * color (eps = factor * value, W m^-3 sr^-1); the grid above
+     * covers their supports too. */
+    veil_vdb* emission[VEIL_MAX_VDB_SOURCES];
+    float emission_factor[VEIL_MAX_VDB_SOURCES][3];
+    int emission_count;
 } veil_scene_volume;
+
+/* The emission on v->grid: a newly calloc'd *rgba (4 floats a voxel: the
+ * emission coefficient eps per channel, W m^-3 sr^-1, and 0), each grid
+ * resampled as the density is (veil_vdb_to_grid). NULL when there is none. */
+veil_result veil_scene_volume_emission(const veil_scene_volume* v, float** rgba, veil_error* err);
 
 /* Native resolution. When the scene gives no medium.max_resolution and has
  * VDB sources, the grid takes the finest VDB voxel edge (not the default

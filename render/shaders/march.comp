@@ -31,6 +31,8 @@
 // J (exp(-sigma_a P) - exp(-sigma_t P)) with J the step's light before
 // attenuation and P the density integral from the camera to the step; its
 // alpha is the luminance-weighted mean of that P.
+// Emission (u.limits.y): the EV's emission texture eps per step, integrated
+// in closed form like in-scattering, added to L (the medium's own light).
 // Output: rgb = L + L_v + T * background, a = 1 - mean(T). With u.limits.x
 // the march ends at the first step boundary at or beyond it (the same steps);
 // with u.flags.w each pixel's ray ends exactly at the distance in u_limit (a
@@ -45,6 +47,7 @@ layout(binding = VEIL_IMAGE_AOV_Q, rgba32f) writeonly uniform image2D u_aov_q; /
 layout(binding = VEIL_TEX_OCC) uniform sampler3D u_occ; // max density per VEIL_BRICK^3 brick (ring included)
 layout(binding = VEIL_TEX_LIMIT) uniform sampler2D u_limit; // u.flags.w: distance (m) where each pixel's ray ends
 layout(binding = VEIL_TEX_DIFFUSION) uniform sampler3D u_phi; // u.diffusion.w: multiply scattered fluence (W/m^2)
+layout(binding = VEIL_TEX_EMISSION) uniform sampler3D u_emission; // u.limits.y: emission eps (W m^-3 sr^-1)
 //@include render/shaders/medium_common.glsl
 
 uint hash32(uint x)
@@ -162,6 +165,13 @@ void main()
         vec3 x = u.cam_pos.xyz + dir * (0.5 * (t + te));
         float rho_dt = in_ev ? texture(u_ev, (x - u.tex_min.xyz) * u.tex_inv_size.xyz).r * dt : 0.0;
         rho_dt = min(rho_dt + fog_integral(u.cam_pos.xyz, dir, t, te), INF); // finite, as D in in_scattered
+        if (in_ev && u.limits.y != 0.0) {
+            // emission eps constant over the step, attenuated within it as in-scattering is:
+            // T eps dt (1 - exp(-x)) / x per channel (dt where the step has no density)
+            vec3 eps = texture(u_emission, (x - u.tex_min.xyz) * u.tex_inv_size.xyz).rgb;
+            vec3 opt = u.sigma_t.rgb * rho_dt;
+            L += T * eps * dt * vec3(veil_step_integral(opt.r), veil_step_integral(opt.g), veil_step_integral(opt.b));
+        }
         if (rho_dt > 0.0) {
             vec3 opt = u.sigma_t.rgb * rho_dt;
             vec3 frac = vec3(veil_step_integral(opt.r), veil_step_integral(opt.g), veil_step_integral(opt.b));
