@@ -12,7 +12,9 @@
 #include <string.h>
 
 static const char* const SOURCE_TYPES[] = {"rbf", "rbf_random", "vdb", "exponential", NULL}; /* = veil_source_type */
-static const char* const VDB_KEYS[] = {"type", "file", "grid", "density_scale", "level_set", "emission", NULL};
+static const char* const VDB_KEYS[] = {"type", "file", "grid", "density_scale", "level_set", "emission", "temperature",
+                                       NULL};
+static const char* const TEMPERATURE_KEYS[] = {"grid", "scale", "offset", "intensity", NULL};
 static const char* const EMISSION_KEYS[] = {"grid", "scale", "color", NULL};
 static const char* const FOG_KEYS[] = {"type", "density", "falloff", "direction", "origin", "bounds", NULL};
 static const char* const RBF_KEYS[] = {"type", "particles", "file", NULL};
@@ -143,6 +145,19 @@ static veil_result parse_vdb(const ctx* c, const cJSON* so, const jpath* sp, vei
     }
     v->level_set_to_fog = ls != NULL;
     free(ls);
+    /* "temperature": {"grid": name (required), "scale" (1), "offset" (0, kelvin), "intensity" (>= 0)} */
+    const jpath tp = {sp, "temperature", 0};
+    const cJSON* to;
+    TRY(veil__jr_get_container(c, so, &tp, false, false, &to));
+    if (to) {
+        TRY(veil__jr_check_keys(c, to, &tp, TEMPERATURE_KEYS));
+        TRY(get_string(c, to, &tp, "grid", true, &v->temperature_grid));
+        double ts = 1.0, toff = 0.0, ti = -1.0;
+        TRY(veil__jr_get_number(c, to, &tp, "scale", false, &VEIL__R_ANY, &ts));
+        TRY(veil__jr_get_number(c, to, &tp, "offset", false, &VEIL__R_ANY, &toff));
+        TRY(veil__jr_get_number(c, to, &tp, "intensity", false, &VEIL__R_NONNEG, &ti));
+        v->temperature_scale = (float)ts, v->temperature_offset = (float)toff, v->temperature_intensity = (float)ti;
+    }
     /* "emission": {"grid": name (required), "scale": >= 0 (1), "color": [3] >= 0 ([1, 1, 1])} */
     const jpath ep = {sp, "emission", 0};
     const cJSON* eo;

@@ -12,6 +12,7 @@ void veil_scene_free(veil_scene* s)
         free(s->medium.sources[i].vdb.file);
         free(s->medium.sources[i].vdb.grid);
         free(s->medium.sources[i].vdb.emission_grid);
+        free(s->medium.sources[i].vdb.temperature_grid);
     }
     free(s->medium.sources);
     free(s->lights);

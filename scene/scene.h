@@ -60,6 +60,14 @@ typedef struct veil_vdb_source {
     char* emission_grid; /* owned */
     float emission_scale;
     float emission_color[3];
+    /* "temperature": {"grid", "scale", "offset", "intensity"}: blackbody
+     * emission, kelvin = scale * value + offset, eps = k rho B_rgb(kelvin)
+     * (volume/blackbody.h), k the medium's sigma_a per channel (Kirchhoff:
+     * what absorbs, emits) unless "intensity" (m^-1 per unit density) is
+     * given; rho this source's density. NULL grid: none */
+    char* temperature_grid; /* owned */
+    float temperature_scale, temperature_offset;
+    float temperature_intensity; /* < 0: sigma_a (the default) */
 } veil_vdb_source;
 
 /* Analytic exponential (height) fog ({"type":"exponential", ...}):

@@ -10,3 +10,5 @@ set_tests_properties(check_layout check_layout_selftest PROPERTIES LABELS unit)
 # Premoze's spread width W (limits, Eq. 1), the level selection and the
 # gathering filter against a direct convolution (render/spread.h's CPU parts).
 veil_test(test_spread_width SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_spread_width.c LABELS unit)
+# Blackbody radiance through the CIE curves to Rec.709 (volume/blackbody.h).
+veil_test(test_blackbody SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_blackbody.c LABELS unit)

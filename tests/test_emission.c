@@ -29,6 +29,7 @@
 #include "frame/renderer.h"
 #include "io/scene.h"
 #include "reference/pathtracer.h"
+#include "volume/blackbody.h"
 
 int main(int argc, char** argv)
 {
@@ -93,8 +94,47 @@ int main(int argc, char** argv)
                    exp(-sa[c] * d), bound);
         }
     veil_image_set_free(&im);
+    veil_scene_free(&s);
+
+    /* Temperature: "heat" read as kelvin = 1500 * value, emission k rho B(T) with
+     * k = sigma_a (Kirchhoff). With eps / sigma_t = B the slab's radiance is
+     * B (1 - exp(-sigma_a d)): a thick absorber glows with the blackbody's
+     * own radiance. 1500 K is a table entry: B is veil_blackbody_rgb(1500). */
+    snprintf(json, sizeof json,
+             "{\"camera\": {\"position\": [0.95, 0.95, 6], \"look_at\": [0.95, 0.95, 0], \"fov_y_deg\": 2,"
+             " \"width\": 5, \"height\": 5},"
+             " \"medium\": {\"sigma_a\": [0.5, 1, 2], \"sigma_s\": [0, 0, 0],"
+             "  \"sources\": [{\"type\": \"vdb\", \"file\": \"%s/emissive_slab.vdb\","
+             "   \"temperature\": {\"grid\": \"heat\", \"scale\": 1500}}]}}",
+             argv[1]);
+    CHECK(veil_scene_parse("temperature.json", json, strlen(json), &s, &err) == VEIL_OK, "%s", err.msg);
+    double B[3];
+    veil_blackbody_rgb(1500.0, B);
+    for (int c = 0; c < 3; ++c) want[c] = B[c] * (1.0 - exp(-sa[c] * d));
+    m = NULL;
+    rgba = se = NULL;
+    CHECK(veil_pt_medium_from_scene(&s, &m, &err) == VEIL_OK, "%s", err.msg);
+    CHECK(m && veil_pt_render(m, &s, &o, &rgba, &se, NULL, &err) == VEIL_OK, "%s", err.msg);
+    for (int c = 0; c < 3 && rgba; ++c) {
+        double got = rgba[4 * 12 + c];
+        CHECK(fabs(got - want[c]) <= 1e-6 * want[c] + 1e-12, "temperature, reference ch %d: %.9g, B (1 - e^-sa d) %.9g",
+              c, got, want[c]);
+        printf("temperature 1500 K, reference ch %d: %.7g, closed form %.7g\n", c, got, want[c]);
+    }
+    free(rgba);
+    free(se);
+    veil_pt_medium_free(m);
+    s.multiple.volumetric = 0, s.multiple.screen_space = 0;
+    CHECK(veil_render_scene_images(r, &s, &(veil_render_opts){.seed = 3}, &im, NULL, &err) == VEIL_OK, "%s", err.msg);
+    for (int c = 0; c < 3 && im.rgba; ++c) {
+        double L = im.aov_s[4 * 12 + c], T = im.aov_t[4 * 12 + c];
+        CHECK(fabs(L - B[c] * (1.0 - T)) <= 1e-5 * B[c] * (1.0 - T) + 1e-12, "temperature, march ch %d: %.7g vs B (1 - T) %.7g",
+              c, L, B[c] * (1.0 - T));
+        printf("temperature 1500 K, march ch %d: %.7g, closed form %.7g\n", c, L, want[c]);
+    }
+    veil_image_set_free(&im);
+    veil_scene_free(&s);
     veil_renderer_destroy(r);
     veil_gl_destroy(gl);
-    veil_scene_free(&s);
     return check_finish();
 }

@@ -8,13 +8,14 @@
 #include <sys/stat.h>
 
 #include "../core/hash.h"
+#include "blackbody.h"
 #include "vdb_volume.h"
 
 void veil_scene_volume_close(veil_scene_volume* v)
 {
     if (!v) return;
     for (int i = 0; i < v->vdb_count; ++i) veil_vdb_close(v->vdbs[i]);
-    for (int i = 0; i < v->emission_count; ++i) veil_vdb_close(v->emission[i]);
+    for (int i = 0; i < v->emission_count; ++i) veil_vdb_close(v->emission[i].grid);
     free(v->particles);
     memset(v, 0, sizeof *v);
 }
@@ -27,6 +28,38 @@ static void grow(float lo[3], float hi[3], int* any, const float a[3], const flo
         hi[k] = *any ? fmaxf(hi[k], b[k]) : b[k];
     }
     *any = 1;
+}
+
+/* Opens source i's emission (temperature: 1) grid, of the same file, and
+ * grows [lo, hi] by its support. The source's density grid is the last
+ * opened (vdbs[vdb_count - 1]). */
+static veil_result open_emission(veil_scene_volume* v, const veil_source* src, size_t i, int temperature, float lo[3],
+                                 float hi[3], int* any, veil_error* err)
+{
+    veil_vdb* e = NULL;
+    veil_error inner = {{0}};
+    const char* name = temperature ? src->vdb.temperature_grid : src->vdb.emission_grid;
+    veil_result r = veil_vdb_open(src->vdb.file, name, 0, &e, NULL, 0, &inner);
+    if (r != VEIL_OK)
+        return veil_fail(err, r, "medium.sources[%zu].%s.grid: %.1900s", i, temperature ? "temperature" : "emission",
+                         inner.msg);
+    veil_emission_source* es = &v->emission[v->emission_count++];
+    memset(es, 0, sizeof *es);
+    es->grid = e;
+    es->temperature = temperature;
+    es->density = v->vdb_count - 1;
+    es->t_scale = src->vdb.temperature_scale, es->t_offset = src->vdb.temperature_offset;
+    for (int c = 0; c < 3; ++c)
+        es->factor[c] = temperature ? src->vdb.temperature_intensity : src->vdb.emission_scale * src->vdb.emission_color[c];
+    int ilo[3], ihi[3];
+    size_t active = 0;
+    r = veil_vdb_index_bbox(e, ilo, ihi, &active);
+    if (r == VEIL_OK && active > 0 && !temperature) { /* a temperature grid emits only where there is density */
+        float a[3], b[3];
+        r = veil_vdb_world_support(e, a, b, err);
+        if (r == VEIL_OK) grow(lo, hi, any, a, b);
+    }
+    return r;
 }
 
 /* Opens source i's grid and grows [lo, hi] by its support. */
@@ -52,22 +85,30 @@ static veil_result open_vdb(veil_scene_volume* v, const veil_source* src, size_t
         if (r == VEIL_OK) grow(lo, hi, any, a, b);
     }
     v->vdb_voxels += active;
-    if (r != VEIL_OK || !src->vdb.emission_grid) return r;
-    /* the emission grid of the same file */
-    veil_vdb* e = NULL;
-    r = veil_vdb_open(src->vdb.file, src->vdb.emission_grid, 0, &e, NULL, 0, &inner);
-    if (r != VEIL_OK) return veil_fail(err, r, "medium.sources[%zu].emission.grid: %.1900s", i, inner.msg);
-    v->emission[v->emission_count] = e;
-    for (int c = 0; c < 3; ++c)
-        v->emission_factor[v->emission_count][c] = src->vdb.emission_scale * src->vdb.emission_color[c];
-    v->emission_count++;
-    r = veil_vdb_index_bbox(e, ilo, ihi, &active);
-    if (r == VEIL_OK && active > 0) {
-        float a[3], b[3];
-        r = veil_vdb_world_support(e, a, b, err);
-        if (r == VEIL_OK) grow(lo, hi, any, a, b);
-    }
+    if (r != VEIL_OK) return r;
+    if (src->vdb.emission_grid) r = open_emission(v, src, i, 0, lo, hi, any, err);
+    if (r == VEIL_OK && src->vdb.temperature_grid) r = open_emission(v, src, i, 1, lo, hi, any, err);
     return r;
+}
+
+#define BB_STEP 10.0     /* K between table entries */
+#define BB_ENTRIES 2001  /* 0 .. 20 000 K */
+
+/* kelvin -> rgb through the table, directly beyond it. */
+static void blackbody(const double (*table)[3], double kelvin, double rgb[3])
+{
+    if (!(kelvin > 0.0)) {
+        rgb[0] = rgb[1] = rgb[2] = 0.0;
+        return;
+    }
+    double u = kelvin / BB_STEP;
+    if (u >= BB_ENTRIES - 1) {
+        veil_blackbody_rgb(kelvin, rgb);
+        return;
+    }
+    int i = (int)u;
+    double f = u - i;
+    for (int c = 0; c < 3; ++c) rgb[c] = table[i][c] + f * (table[i + 1][c] - table[i][c]);
 }
 
 veil_result veil_scene_volume_emission(const veil_scene_volume* v, float** rgba, veil_error* err)
@@ -77,14 +118,40 @@ veil_result veil_scene_volume_emission(const veil_scene_volume* v, float** rgba,
     size_t n = veil_grid_voxels(&v->grid);
     float* out = calloc(n * 4, sizeof *out);
     float* one = malloc(n * sizeof *one);
-    veil_result r = out && one ? VEIL_OK : veil_fail(err, VEIL_ERR_OOM, "out of memory for a %zu-voxel emission", n);
+    float* rho = malloc(n * sizeof *rho);
+    double(*table)[3] = malloc(BB_ENTRIES * sizeof *table);
+    veil_result r = out && one && rho && table ? VEIL_OK
+                                               : veil_fail(err, VEIL_ERR_OOM, "out of memory for a %zu-voxel emission", n);
+    int tabulated = 0;
     for (int i = 0; i < v->emission_count && r == VEIL_OK; ++i) {
+        const veil_emission_source* es = &v->emission[i];
         memset(one, 0, n * sizeof *one);
-        r = veil_vdb_to_grid(v->emission[i], 1.0f, &v->grid, one, err);
-        for (size_t k = 0; k < n && r == VEIL_OK; ++k)
-            for (int c = 0; c < 3; ++c) out[4 * k + (size_t)c] += v->emission_factor[i][c] * one[k];
+        r = veil_vdb_to_grid(es->grid, 1.0f, &v->grid, one, err);
+        if (r != VEIL_OK) break;
+        if (!es->temperature) {
+            for (size_t k = 0; k < n; ++k)
+                for (int c = 0; c < 3; ++c) out[4 * k + (size_t)c] += es->factor[c] * one[k];
+            continue;
+        }
+        if (!tabulated) {
+            for (int t = 0; t < BB_ENTRIES; ++t) veil_blackbody_rgb(t * BB_STEP, table[t]);
+            tabulated = 1;
+        }
+        memset(rho, 0, n * sizeof *rho);
+        r = veil_vdb_to_grid(v->vdbs[es->density], v->vdb_scale[es->density], &v->grid, rho, err);
+        for (size_t k = 0; k < n && r == VEIL_OK; ++k) {
+            if (!(rho[k] > 0.0f)) continue;
+            double bb[3];
+            blackbody((const double(*)[3])table, (double)es->t_scale * one[k] + es->t_offset, bb);
+            for (int c = 0; c < 3; ++c) {
+                double kc = es->factor[c] >= 0.0f ? es->factor[c] : v->sigma_a[c];
+                out[4 * k + (size_t)c] += (float)(kc * rho[k] * bb[c]);
+            }
+        }
     }
     free(one);
+    free(rho);
+    free(table);
     if (r != VEIL_OK) {
         free(out);
         return r;
@@ -138,6 +205,12 @@ uint64_t veil_scene_volume_key(const veil_scene* s)
             k = veil_hash_bytes(k, eg, strlen(eg) + 1);
             k = veil_hash_bytes(k, &src->vdb.emission_scale, sizeof src->vdb.emission_scale);
             k = veil_hash_bytes(k, src->vdb.emission_color, sizeof src->vdb.emission_color);
+            const char* tg = src->vdb.temperature_grid ? src->vdb.temperature_grid : "";
+            k = veil_hash_bytes(k, tg, strlen(tg) + 1);
+            k = veil_hash_bytes(k, &src->vdb.temperature_scale, sizeof src->vdb.temperature_scale);
+            k = veil_hash_bytes(k, &src->vdb.temperature_offset, sizeof src->vdb.temperature_offset);
+            k = veil_hash_bytes(k, &src->vdb.temperature_intensity, sizeof src->vdb.temperature_intensity);
+            k = veil_hash_bytes(k, s->medium.sigma_a, sizeof s->medium.sigma_a); /* Kirchhoff's k */
         }
     }
     return k;
@@ -235,6 +308,7 @@ veil_result veil_scene_volume_open(const veil_scene* s, veil_scene_volume* out, 
     memset(&v, 0, sizeof v);
     memset(out, 0, sizeof *out);
     v.key = veil_scene_volume_key(s);
+    memcpy(v.sigma_a, s->medium.sigma_a, sizeof v.sigma_a);
     veil_result r = veil_scene_particles(s, &v.particles, &v.particle_count, err);
     float lo[3], hi[3], a[3], b[3];
     int any = 0;

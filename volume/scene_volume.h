@@ -26,6 +26,15 @@
 /* At most this many OpenVDB grids in one scene. */
 #define VEIL_MAX_VDB_SOURCES 8
 
+/* One emitting grid of a vdb source. */
+typedef struct veil_emission_source {
+    veil_vdb* grid;        /* the emission or temperature grid (owned) */
+    int temperature;       /* 0: eps = factor * value; 1: blackbody of kelvin = t_scale * value + t_offset */
+    float factor[3];       /* emission: scale * color; temperature: k (m^-1 per unit density) per channel */
+    float t_scale, t_offset;
+    int density;           /* temperature: the index in vdbs[] of the source's density grid */
+} veil_emission_source;
+
 typedef struct veil_scene_volume {
     veil_particle* particles; /* all RBF particles (owned) */
     size_t particle_count;
@@ -38,17 +47,19 @@ typedef struct veil_scene_volume {
     veil_grid grid;
     /* How the grid was chosen, for --stats: "native: ..." or "resampled: ..." */
     char resolution[192];
-    /* Emission grids ("emission" of a vdb source, owned) and their factor
-     * scale * color (eps = factor * value, W m^-3 sr^-1); the grid above
-     * covers their supports too. */
-    veil_vdb* emission[VEIL_MAX_VDB_SOURCES];
-    float emission_factor[VEIL_MAX_VDB_SOURCES][3];
+    /* Emission ("emission" and "temperature" of vdb sources); the grid
+     * above covers their supports too. */
+    veil_emission_source emission[2 * VEIL_MAX_VDB_SOURCES];
     int emission_count;
+    float sigma_a[3]; /* the medium's, for temperature grids' Kirchhoff emission */
 } veil_scene_volume;
 
 /* The emission on v->grid: a newly calloc'd *rgba (4 floats a voxel: the
  * emission coefficient eps per channel, W m^-3 sr^-1, and 0), each grid
- * resampled as the density is (veil_vdb_to_grid). NULL when there is none. */
+ * resampled as the density is (veil_vdb_to_grid). A temperature grid
+ * emits k rho B_rgb(kelvin) (volume/blackbody.h; B tabulated every 10 K to
+ * 20 000 K and interpolated linearly, computed directly above). NULL when
+ * there is none. */
 veil_result veil_scene_volume_emission(const veil_scene_volume* v, float** rgba, veil_error* err);
 
 /* Native resolution. When the scene gives no medium.max_resolution and has
