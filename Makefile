@@ -2,7 +2,7 @@
 #   make        configure and build into build/ (the tool is build/veil)
 #   make demo   install missing packages, build, render the demo scene
 #   make test   install missing packages, build, run every test (ctest)
-#   make data   generate the smoke VDB that data/scenes/vdb_smoke.json renders
+#   make data   generate the VDBs that data/scenes/vdb_smoke.json and pyro.json render
 #   make accuracy  time against error of the GPU path vs the CPU reference
 #                  (bench/accuracy --quick, under 2 minutes; FULL=1: the full sweep)
 BUILD ?= build
@@ -36,6 +36,7 @@ data:
 	@$(MAKE) --no-print-directory deps
 	@$(MAKE) --no-print-directory build
 	@$(BUILD)/tests/make_test_vdbs --plume data/generated/smoke_plume.vdb
+	@$(BUILD)/tests/make_test_vdbs --pyro data/generated/pyro_plume.vdb
 
 # Results go to docs/results/accuracy[-quick].{csv,png,gp,txt}; references are
 # cached in $(BUILD)/bench-cache. Extra arguments: ACCURACY_ARGS="--runs 5".

@@ -4,6 +4,7 @@
 //   make_test_vdbs DIR           the test files (below), deterministic
 //   make_test_vdbs DIR --big     also big_plume.vdb (~10^6 active voxels, for timing)
 //   make_test_vdbs --plume FILE  only the plume, at the size of big_plume.vdb, into FILE
+//   make_test_vdbs --pyro FILE   the base-size plume with a "temperature" grid (0..1), into FILE
 //                                (the example scene data/scenes/vdb_smoke.json: `make data`)
 //
 // Files (grid name, what it is for):
@@ -126,6 +127,25 @@ FloatGrid::Ptr plume(double s)
     return g;
 }
 
+// The plume's temperature for a pyro test: on the plume's voxels, hottest at
+// the base and the axis, value (1 - t)(1 - d^2) in [0, 1] (a scene maps it
+// to kelvin with "scale" and "offset").
+FloatGrid::Ptr plume_temperature(const FloatGrid& density)
+{
+    FloatGrid::Ptr g = float_grid("temperature", 0.02);
+    FloatGrid::Accessor acc = g->getAccessor();
+    openvdb::CoordBBox box = density.evalActiveVoxelBoundingBox();
+    const double height = box.max().y() + 1.0;
+    for (FloatGrid::ValueOnCIter it = density.cbeginValueOn(); it; ++it) {
+        const Coord c = it.getCoord();
+        double t = c.y() / height, r = 10.0 + 15.0 * t, cx = 4.0 * std::sin(6.0 * t) * (r / (10.0 + 15.0 * t));
+        double d = std::sqrt((c.x() - cx) * (c.x() - cx) + (double)c.z() * c.z()) / r;
+        double v = (1.0 - t) * (1.0 - std::min(d * d, 1.0));
+        if (v > 0.0) acc.setValue(c, (float)v);
+    }
+    return g;
+}
+
 void copy_prefix(const char* from, const char* to, double fraction)
 {
     std::ifstream in(path(from), std::ios::binary);
@@ -231,13 +251,15 @@ void make_all(bool big)
 
 int main(int argc, char** argv)
 {
-    if (argc == 3 && std::strcmp(argv[1], "--plume") == 0) {
+    if (argc == 3 && (std::strcmp(argv[1], "--plume") == 0 || std::strcmp(argv[1], "--pyro") == 0)) {
         std::filesystem::path file(argv[2]);
         g_dir = file.has_parent_path() ? file.parent_path().string() : std::string(".");
         try {
             std::filesystem::create_directories(g_dir);
             openvdb::initialize();
-            write(file.filename().string().c_str(), {plume(2.2)});
+            FloatGrid::Ptr p = plume(std::strcmp(argv[1], "--pyro") == 0 ? 1.0 : 2.2);
+            if (std::strcmp(argv[1], "--pyro") == 0) write(file.filename().string().c_str(), {p, plume_temperature(*p)});
+            else write(file.filename().string().c_str(), {p});
         } catch (const std::exception& e) {
             std::fprintf(stderr, "make_test_vdbs: %s\n", e.what());
             return 1;
@@ -246,7 +268,7 @@ int main(int argc, char** argv)
         return 0;
     }
     if (argc < 2 || argc > 3 || (argc == 3 && std::strcmp(argv[2], "--big") != 0)) {
-        std::fprintf(stderr, "usage: %s DIR [--big] | --plume FILE\n", argv[0]);
+        std::fprintf(stderr, "usage: %s DIR [--big] | --plume FILE | --pyro FILE\n", argv[0]);
         return 2;
     }
     g_dir = argv[1];
