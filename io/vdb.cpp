@@ -41,6 +41,7 @@ struct veil_vdb {
     FloatGrid::Ptr grid;         // read-only once opened
     CoordBBox active_box;        // computed once: the grid does not change
     openvdb::Index64 active = 0;
+    std::string others;          // the file's other grids, "name (type)", comma-separated
 };
 
 namespace {
@@ -352,7 +353,10 @@ veil_result veil_vdb_open(const char* path, const char* grid_name, int level_set
         if (!grid) fail_with(VEIL_ERR_IO, where + ": OpenVDB returned no float grid");
         if (grid->getGridClass() == openvdb::GRID_LEVEL_SET) openvdb::tools::sdfToFogVolume(*grid);
         zero_inactive(*grid);
-        v = new veil_vdb{path, name, grid, grid->evalActiveVoxelBoundingBox(), grid->activeVoxelCount()};
+        std::string others;
+        for (const auto& g : metas)
+            if (g->getName() != name) others += (others.empty() ? "" : ", ") + g->getName() + " (" + g->valueType() + ")";
+        v = new veil_vdb{path, name, grid, grid->evalActiveVoxelBoundingBox(), grid->activeVoxelCount(), others};
     });
     if (r != VEIL_OK) return r;
     copy_name(v->name, chosen_name, chosen_len);
@@ -367,6 +371,7 @@ void veil_vdb_close(veil_vdb* v)
 
 const char* veil_vdb_path(const veil_vdb* v) { return v ? v->path.c_str() : ""; }
 const char* veil_vdb_grid_name(const veil_vdb* v) { return v ? v->name.c_str() : ""; }
+const char* veil_vdb_other_grids(const veil_vdb* v) { return v ? v->others.c_str() : ""; }
 
 veil_result veil_vdb_transform(const veil_vdb* v, double index_to_world[4][4], veil_error* err)
 {

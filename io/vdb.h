@@ -58,6 +58,10 @@ void veil_vdb_close(veil_vdb* v);
 /* The file and grid name, for messages (owned by v). */
 const char* veil_vdb_path(const veil_vdb* v);
 const char* veil_vdb_grid_name(const veil_vdb* v);
+/* The file's other grids, "name (value type)" comma-separated ("" when
+ * none): what was not read, for reports (velocity grids and the like are
+ * ignored unless a source asks for them). Owned by v. */
+const char* veil_vdb_other_grids(const veil_vdb* v);
 
 /* The affine index-to-world map as a 4x4 matrix acting on column vectors:
  * world[r] = sum_c m[r][c] * (i, j, k, 1)[c]; the last row is 0 0 0 1.

@@ -50,6 +50,12 @@ function(veil_vdb_cli name rc text)
   set_tests_properties(vdb_cli_${name} PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "cli;unit")
 endfunction()
 veil_vdb_cli(info_table 0 "density" info ${VDB_DATA}/offset_scaled.vdb)
+# render says which grids of a file it did not read (and at which resolution it read the one it did)
+file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/two_grids_scene.json
+  "{\"camera\": {\"position\": [0, 0, 3], \"look_at\": [0, 0, 0], \"width\": 16, \"height\": 12},
+    \"medium\": {\"sigma_s\": [1, 1, 1], \"sources\": [{\"type\": \"vdb\", \"file\": \"${VDB_DATA}/two_grids.vdb\"}]}}\n")
+veil_vdb_cli(render_unread 0 "values copied; not read: temperature (float)" render
+             ${CMAKE_CURRENT_BINARY_DIR}/two_grids_scene.json -o ${CMAKE_CURRENT_BINARY_DIR}/two_grids_out.exr --stats)
 veil_vdb_cli(info_table_count 0 "4096" info ${VDB_DATA}/offset_scaled.vdb)
 # what render will do with a grid: copy it (axis-aligned cubes) or resample it (rotated)
 veil_vdb_cli(info_native 0 "rendering native: axis-aligned 0.25 m cubes, values copied" info ${VDB_DATA}/offset_scaled.vdb)

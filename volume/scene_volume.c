@@ -302,6 +302,31 @@ static veil_result choose_grid(const veil_scene* s, veil_scene_volume* v, const 
     return r;
 }
 
+/* Appends to v->resolution the grids of vdb i's file that nothing read:
+ * neither the density nor an emission or temperature grid of it. */
+static void note_unread(veil_scene_volume* v, int i)
+{
+    char unread[256] = "";
+    const char* p = veil_vdb_other_grids(v->vdbs[i]);
+    while (*p) {
+        const char* end = strstr(p, ", ");
+        size_t n = end ? (size_t)(end - p) : strlen(p);
+        int used = 0;
+        for (int e = 0; e < v->emission_count; ++e) {
+            const char* name = veil_vdb_grid_name(v->emission[e].grid);
+            size_t k = strlen(name);
+            used |= v->emission[e].density == i && n > k + 1 && strncmp(p, name, k) == 0 && p[k] == ' ';
+        }
+        size_t len = strlen(unread);
+        if (!used && len + n + 3 < sizeof unread) snprintf(unread + len, sizeof unread - len, "%s%.*s", len ? ", " : "", (int)n, p);
+        p += n;
+        if (end) p += 2;
+    }
+    size_t len = strlen(v->resolution);
+    if (*unread && len + 16 < sizeof v->resolution)
+        snprintf(v->resolution + len, sizeof v->resolution - len, "; not read: %s", unread);
+}
+
 veil_result veil_scene_volume_open(const veil_scene* s, veil_scene_volume* out, veil_error* err)
 {
     veil_scene_volume v;
@@ -319,6 +344,8 @@ veil_result veil_scene_volume_open(const veil_scene* s, veil_scene_volume* out, 
         if (any) r = choose_grid(s, &v, lo, hi, err);
         v.has_volume = any;
     }
+    /* say which grids of the files were not read (velocity and the like) */
+    for (int i = 0; i < v.vdb_count && r == VEIL_OK; ++i) note_unread(&v, i);
     if (r != VEIL_OK) {
         veil_scene_volume_close(&v);
         return r;

@@ -45,8 +45,9 @@ typedef struct veil_scene_volume {
     uint64_t key;      /* veil_scene_volume_key() of the scene */
     int has_volume;    /* 0: nothing to voxelise (then `grid` is unset) */
     veil_grid grid;
-    /* How the grid was chosen, for --stats: "native: ..." or "resampled: ..." */
-    char resolution[192];
+    /* How the grid was chosen, for --stats: "native: ..." or "resampled: ...",
+     * and the files' grids that were not read ("; read 'density', not: vel (vec3s)") */
+    char resolution[320];
     /* Emission ("emission" and "temperature" of vdb sources); the grid
      * above covers their supports too. */
     veil_emission_source emission[2 * VEIL_MAX_VDB_SOURCES];
