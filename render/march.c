@@ -9,7 +9,7 @@
 #include "../scene/camera.h"
 
 struct veil_march {
-    GLuint program, ubo;
+    GLuint program, program_emission, ubo; /* the march, and its variant with emission */
 };
 
 veil_result veil_march_create(veil_march** out, veil_error* err)
@@ -18,6 +18,21 @@ veil_result veil_march_create(veil_march** out, veil_error* err)
     veil_march* m = calloc(1, sizeof *m);
     if (!m) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the ray marcher");
     veil_result r = veil_gpu_program("render/shaders/march.comp", &m->program, err);
+    if (r == VEIL_OK) {
+        /* the emission variant: the same file with VEIL_MARCH_EMISSION defined */
+        const char* src = veil_shader_source("render/shaders/march.comp", 0);
+        static const char prefix[] = "#define VEIL_MARCH_EMISSION 1\n";
+        size_t n = src ? strlen(src) : 0;
+        char* text = src ? malloc(sizeof prefix + n) : NULL;
+        if (!text) {
+            r = veil_fail(err, VEIL_ERR_OOM, "out of memory for the march's emission variant");
+        } else {
+            memcpy(text, prefix, sizeof prefix - 1);
+            memcpy(text + sizeof prefix - 1, src, n + 1);
+            r = veil_gl_compute_program("render/shaders/march.comp (emission)", text, &m->program_emission, err);
+            free(text);
+        }
+    }
     if (r == VEIL_OK)
         r = veil_gl_buffer(NULL, sizeof(veil_march_block), GL_DYNAMIC_STORAGE_BIT, "veil march block", &m->ubo, err);
     if (r != VEIL_OK) {
@@ -32,6 +47,7 @@ void veil_march_destroy(veil_march* m)
 {
     if (!m) return;
     glDeleteProgram(m->program);
+    glDeleteProgram(m->program_emission);
     glDeleteBuffers(1, &m->ubo);
     free(m);
 }
@@ -153,7 +169,7 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
     if (r == VEIL_OK) {
         out->width = w, out->height = h;
         glNamedBufferSubData(m->ubo, 0, sizeof u, &u);
-        glUseProgram(m->program);
+        glUseProgram(d->grid && d->emission ? m->program_emission : m->program);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, m->ubo);
         glBindTextureUnit(VEIL_TEX_EV, d->grid ? d->ev : 0);
         glBindTextureUnit(VEIL_TEX_OCC, d->grid ? d->occupancy : 0);

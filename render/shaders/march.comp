@@ -31,8 +31,9 @@
 // J (exp(-sigma_a P) - exp(-sigma_t P)) with J the step's light before
 // attenuation and P the density integral from the camera to the step; its
 // alpha is the luminance-weighted mean of that P.
-// Emission (u.limits.y): the EV's emission texture eps per step, integrated
-// in closed form like in-scattering, added to L (the medium's own light).
+// Emission (u.limits.y, in the variant compiled with VEIL_MARCH_EMISSION):
+// the EV's emission texture eps per step, integrated in closed form like
+// in-scattering, added to L (the medium's own light).
 // Output: rgb = L + L_v + T * background, a = 1 - mean(T). With u.limits.x
 // the march ends at the first step boundary at or beyond it (the same steps);
 // with u.flags.w each pixel's ray ends exactly at the distance in u_limit (a
@@ -94,7 +95,8 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
         for (int i = 1; i < octaves; ++i) {
             a *= u.octave.x, g *= u.octave.z;
             b *= u.octave.y * per * albedo;
-            multi += b * E * exp(-max(a * u.sigma_t.rgb, floor_t) * D) * veil_phase_hg(cos_theta, g);
+            vec3 att = exp(-max(a * u.sigma_t.rgb, floor_t) * D);
+            multi += b * E * att * veil_phase_hg(cos_theta, g);
         }
     }
     // the diffusion estimate: the fluence of light scattered at least once,
@@ -165,6 +167,7 @@ void main()
         vec3 x = u.cam_pos.xyz + dir * (0.5 * (t + te));
         float rho_dt = in_ev ? texture(u_ev, (x - u.tex_min.xyz) * u.tex_inv_size.xyz).r * dt : 0.0;
         rho_dt = min(rho_dt + fog_integral(u.cam_pos.xyz, dir, t, te), INF); // finite, as D in in_scattered
+#ifdef VEIL_MARCH_EMISSION /* a variant: llvmpipe runs a masked-off texture read anyway (10 % of the march) */
         if (in_ev && u.limits.y != 0.0) {
             // emission eps constant over the step, attenuated within it as in-scattering is:
             // T eps dt (1 - exp(-x)) / x per channel (dt where the step has no density)
@@ -172,6 +175,7 @@ void main()
             vec3 opt = u.sigma_t.rgb * rho_dt;
             L += T * eps * dt * vec3(veil_step_integral(opt.r), veil_step_integral(opt.g), veil_step_integral(opt.b));
         }
+#endif
         if (rho_dt > 0.0) {
             vec3 opt = u.sigma_t.rgb * rho_dt;
             vec3 frac = vec3(veil_step_integral(opt.r), veil_step_integral(opt.g), veil_step_integral(opt.b));
