@@ -42,6 +42,8 @@ veil_vdb_case(scene_volume unit)
 veil_vdb_case(native "unit;accuracy")
 # NanoVDB (.nvdb) files read like OpenVDB files, by the reader and `veil info`
 veil_vdb_case(nanovdb unit)
+# the resampling filter by direction: the field at the centres beats a box filter when not reducing
+veil_vdb_case(filters "unit;accuracy")
 
 # `veil info` (tests/vdb_bad.sh VEIL EXPECTED_EXIT EXPECTED_TEXT ARGS...).
 function(veil_vdb_cli name rc text)

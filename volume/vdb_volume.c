@@ -176,7 +176,13 @@ veil_result veil_vdb_plan_resample(const veil_vdb* v, const veil_grid* g, veil_v
     if (!(h > 0.0) || !isfinite(h))
         return veil_fail(err, VEIL_ERR_INVALID, "%s: grid '%s': the transform's voxel size is %g", veil_vdb_path(v),
                          veil_vdb_grid_name(v), h);
-    double want = ceil(VEIL_VDB_SAMPLES_PER_VOXEL * (double)g->voxel / h - VDB_K_ROUNDING);
+    /* Reducing (target voxel larger than the VDB's): the box filter. Not reducing
+     * (the same size under a rotation, or enlarging): the field at each target
+     * centre, k = 1, the trilinear field itself (a box mean there would only
+     * blur; tests/test_vdb.c "filters" measures both). */
+    double want = (double)g->voxel <= h * (1.0 + VDB_K_ROUNDING)
+                      ? 1.0
+                      : ceil(VEIL_VDB_SAMPLES_PER_VOXEL * (double)g->voxel / h - VDB_K_ROUNDING);
     int k = want < 1.0 ? 1 : want > VEIL_VDB_MAX_SUPERSAMPLE ? VEIL_VDB_MAX_SUPERSAMPLE : (int)want;
     size_t samples = 0;
     for (; k >= 1; --k)

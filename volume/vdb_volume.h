@@ -9,7 +9,10 @@
  * integrates to one voxel's volume.
  *
  * veil_vdb_to_grid sets each target voxel to the mean of that field over
- * the voxel's cube (a box filter), so sum(density) x voxel^3 equals the
+ * the voxel's cube (a box filter) when the target's voxels are larger than
+ * the VDB's (reducing), and to the field at the voxel's centre (k = 1: the
+ * trilinear field, no extra blur) when they are not (the same size under a
+ * rotation, or enlarging). With the box filter sum(density) x voxel^3 equals the
  * VDB's mass whenever the target's cubes cover the field's support
  * (veil_vdb_world_support). The mean is estimated with k^3 samples on a
  * regular k x k x k lattice at the centres of the cube's sub-cells
