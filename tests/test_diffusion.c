@@ -77,8 +77,6 @@ static void escape_cube(veil_diffusion* d)
                 for (int a = 0; a < 3; ++a) inside &= lo[a] + c[a] * rep.cell <= hi[a] + 1e-6;
                 if (!inside) continue;
                 double got = P[4 * (((size_t)k * dims[1] + j) * dims[0] + i)];
-                if (fabs(got - want) > worst && getenv("DEBUG_ESCAPE"))
-                    printf("cell %d %d %d: got %.6f want %.6f\n", i, j, k, got, want);
                 worst = fmax(worst, fabs(got - want));
             }
     CHECK(worst <= 1e-5, "escape field vs closed form: worst difference %.3g > 1e-5", worst);
