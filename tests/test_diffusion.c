@@ -55,11 +55,10 @@ static void escape_cube(veil_diffusion* d)
         for (int j = 0; j < dims[1]; ++j)
             for (int i = 0; i < dims[0]; ++i) {
                 const int c[3] = {i, j, k};
-                double sum = 0.0, m = INFINITY;
+                double sum = 0.0;
                 for (int a = 0; a < 3; ++a) {
                     double x = lo[a] + c[a] * rep.cell, dlo = fmax(x - lo[a], 0.0), dhi = fmax(hi[a] - x, 0.0);
                     sum += 2.0 - exp(-st * rho * dlo) - exp(-st * rho * dhi);
-                    (void)m;
                 }
                 /* diagonals: each of the 8 sign patterns exits at the nearest face along it */
                 for (int sgn = 0; sgn < 8; ++sgn) {
