@@ -35,8 +35,8 @@ static void print_info_grid(const veil_vdb_grid_info* g)
     else if (cubes)
         printf("  rendering    native: axis-aligned %g m cubes, values copied (without medium.max_resolution)\n", s);
     else
-        printf("  rendering    resampled at its smallest voxel edge (box filter): its voxels are rotated or not "
-               "cubes\n");
+        printf("  rendering    resampled at its smallest voxel edge (the field at each voxel centre): its voxels are "
+               "rotated or not cubes\n");
 }
 
 int veil_cmd_info(int argc, char** argv)

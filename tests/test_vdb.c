@@ -735,6 +735,25 @@ static void test_native(void)
     veil_scene_volume_close(&v);
     veil_scene_free(&s);
 
+    /* two sources of different voxel sizes: the finest (fog_sphere's 0.05 m) on its lattice */
+    {
+        char a[4200], b[4200], json[9000];
+        snprintf(a, sizeof a, "%s/offset_scaled.vdb", g_dir);
+        snprintf(b, sizeof b, "%s/fog_sphere.vdb", g_dir);
+        snprintf(json, sizeof json,
+                 "{\"camera\": {\"position\": [0, 0, 9], \"look_at\": [0, 0, 0]},"
+                 " \"medium\": {\"sigma_s\": [1, 1, 1], \"sources\": [{\"type\": \"vdb\", \"file\": \"%s\"},"
+                 " {\"type\": \"vdb\", \"file\": \"%s\"}]}}", a, b);
+        CHECK(veil_scene_parse("two.json", json, strlen(json), &s, &err) == VEIL_OK, "%s", err.msg);
+        memset(&v, 0, sizeof v);
+        CHECK(veil_scene_volume_open(&s, &v, &err) == VEIL_OK, "%s", err.msg);
+        printf("two sources: %s, grid %dx%dx%d\n", v.resolution, v.grid.dims[0], v.grid.dims[1], v.grid.dims[2]);
+        CHECK(fabsf(v.grid.voxel - 0.05f) < 1e-6f && strncmp(v.resolution, "native", 6) == 0,
+              "two sources: the finest voxel (0.05 m) natively: %g, '%s'", v.grid.voxel, v.resolution);
+        veil_scene_volume_close(&v);
+        veil_scene_free(&s);
+    }
+
     if (open_scene("rotated.vdb", "", &s, &v) != VEIL_OK) {
         CHECK(0, "open rotated.vdb");
         return;

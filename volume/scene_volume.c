@@ -268,11 +268,11 @@ static int native_grid(const veil_scene_volume* v, const float lo[3], const floa
     for (int a = 0; a < 3; ++a) g->dims[a] = dims[a], g->origin[a] = (float)org[a];
     g->voxel = (float)edge;
     if (aligned)
-        snprintf(note, note_len, "native: the VDB's %.4g m voxels, %dx%dx%d, values copied", edge, dims[0], dims[1],
-                 dims[2]);
+        snprintf(note, note_len, "native: the VDB's %.4g m voxels, %dx%dx%d, values copied%s", edge, dims[0], dims[1],
+                 dims[2], v->vdb_count > 1 ? " (the finest grid; the others resampled onto it)" : "");
     else
-        snprintf(note, note_len, "native voxel size %.4g m, resampled (box filter): the VDB's voxels are rotated "
-                 "or not cubes", edge);
+        snprintf(note, note_len, "native voxel size %.4g m, resampled (the field at each voxel centre): the VDB's "
+                 "voxels are rotated or not cubes", edge);
     return 1;
 }
 
