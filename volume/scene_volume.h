@@ -68,7 +68,7 @@ veil_result veil_scene_volume_emission(const veil_scene_volume* v, float** rgba,
  * 128 voxels), placed on the lattice of the first VDB with that edge whose
  * voxels are axis-aligned cubes, so that its values are copied exactly
  * (volume/vdb_volume.h); a rotated or sheared VDB is resampled at its own
- * voxel edge (box filter). Above VEIL_NATIVE_MAX_VOXELS voxels (or 2048 a
+ * voxel edge (the field at each centre). Above VEIL_NATIVE_MAX_VOXELS voxels (or 2048 a
  * side) the grid is resampled down to fit, and says so. An explicit
  * max_resolution is a cap the user chose: the grid is fitted to it as
  * before. */
