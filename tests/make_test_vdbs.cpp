@@ -15,6 +15,7 @@
 //   offset_scaled.vdb    "density": voxel 0.25 m, translated by (1, -2, 3); the linear field
 //                        1 + i/2 + j/4 + k/8 on the index block [0, 15]^3 (pins the convention)
 //   offset_scaled.nvdb   the same grid written by NanoVDB (io/vdb.cpp reads .nvdb too)
+//   offset_scaled_half.vdb the same grid stored as half floats (values exact in half)
 //   emissive_slab.vdb    "density" and "heat" 1 on [0,19]x[0,19]x[0,9], voxel 0.1 m
 //   rotated.vdb          "density": a Gaussian blob under scale + rotation + translation
 //   frustum.vdb          "density": a frustum (non-affine) transform
@@ -199,6 +200,13 @@ void make_all(bool big)
                 for (int i = 0; i < 20; ++i) a.setValue(Coord(i, j, k), 1.0f), b.setValue(Coord(i, j, k), 1.0f);
     }
     write("emissive_slab.vdb", {slab, heat});
+    // the same grid stored as half floats (as production files often are): its values (multiples
+    // of 1/8 below 16) are exact in half, so a reader must return them bit for bit
+    {
+        FloatGrid::Ptr half = lin->deepCopy();
+        half->setSaveFloatAsHalf(true);
+        write("offset_scaled_half.vdb", {half});
+    }
     // the same grid as NanoVDB (pbrt-v4's scenes ship .nvdb): readers must see the same values
     nanovdb::io::writeGrid(path("offset_scaled.nvdb"), nanovdb::openToNanoVDB(*lin));
 

@@ -765,15 +765,17 @@ static void test_native(void)
     veil_scene_free(&s);
 }
 
-/* A NanoVDB file is read like an OpenVDB file: offset_scaled.nvdb holds
+/* A NanoVDB file is read like an OpenVDB file (and a half-float OpenVDB
+ * file exactly, where its values are exact in half): offset_scaled.nvdb holds
  * the same grid as offset_scaled.vdb (make_test_vdbs writes both), so the
  * reader must give the same name, index box, active count, transform and
  * values, bit for bit (a float NanoVDB grid stores the floats as they are). */
 static void test_nanovdb(void)
 {
-    char a[4200], b[4200];
+    char a[4200], b[4200], hpath[4200];
     snprintf(a, sizeof a, "%s/offset_scaled.vdb", g_dir);
     snprintf(b, sizeof b, "%s/offset_scaled.nvdb", g_dir);
+    snprintf(hpath, sizeof hpath, "%s/offset_scaled_half.vdb", g_dir);
     veil_vdb *va = NULL, *vb = NULL;
     veil_error err = {0};
     char name[64] = "";
@@ -797,6 +799,15 @@ static void test_nanovdb(void)
     float da[16 * 16 * 16], db[16 * 16 * 16];
     CHECK(veil_vdb_dense(va, alo, ahi, da) == VEIL_OK && veil_vdb_dense(vb, alo, ahi, db) == VEIL_OK, "dense reads");
     CHECK(memcmp(da, db, sizeof da) == 0, "values differ");
+    /* a half-float file of the same (half-exact) values: read exactly */
+    veil_vdb* vh = NULL;
+    CHECK(veil_vdb_open(hpath, NULL, 0, &vh, NULL, 0, &err) == VEIL_OK, "%s", err.msg);
+    if (vh) {
+        float dh[16 * 16 * 16];
+        CHECK(veil_vdb_dense(vh, alo, ahi, dh) == VEIL_OK && memcmp(da, dh, sizeof da) == 0,
+              "the half-float file's values differ from the float file's");
+        veil_vdb_close(vh);
+    }
     veil_vdb_grid_info* info = NULL;
     size_t count = 0;
     CHECK(veil_vdb_file_info(b, &info, &count, &err) == VEIL_OK && count == 1 && info &&
