@@ -169,6 +169,15 @@ openvdb::GridPtrVec read_nanovdb(const std::string& path)
     return out;
 }
 
+// The grids of a file: an OpenVDB file's metadata (file is opened, the trees
+// are read on demand), or a NanoVDB file's grids whole (file is not used).
+openvdb::GridPtrVec file_grids(openvdb::io::File& file, const std::string& path, bool nano)
+{
+    if (nano) return read_nanovdb(path);
+    open_file(file, path);
+    return *file.readAllGridMetadata();
+}
+
 // The grid to load: the named one, or the default (see vdb.h).
 GridBase::Ptr choose(const std::string& path, const openvdb::GridPtrVec& grids, const char* want)
 {
@@ -331,13 +340,7 @@ veil_result veil_vdb_open(const char* path, const char* grid_name, int level_set
     veil_result r = guarded(err, path, [&] {
         const bool nano = is_nanovdb(path);
         openvdb::io::File file(path);
-        openvdb::GridPtrVec metas;
-        if (nano) {
-            metas = read_nanovdb(path);
-        } else {
-            open_file(file, path);
-            metas = *file.readAllGridMetadata();
-        }
+        openvdb::GridPtrVec metas = file_grids(file, path, nano);
         GridBase::Ptr meta = choose(path, metas, grid_name);
         const std::string name = meta->getName(), where = std::string(path) + ": grid " + quoted(name);
         if (!meta->isType<FloatGrid>())
@@ -441,13 +444,7 @@ veil_result veil_vdb_file_info(const char* path, veil_vdb_grid_info** grids, siz
     veil_result r = guarded(err, path, [&] {
         const bool nano = is_nanovdb(path);
         openvdb::io::File file(path);
-        openvdb::GridPtrVec metas;
-        if (nano) {
-            metas = read_nanovdb(path);
-        } else {
-            open_file(file, path);
-            metas = *file.readAllGridMetadata();
-        }
+        openvdb::GridPtrVec metas = file_grids(file, path, nano);
         out = static_cast<veil_vdb_grid_info*>(std::calloc(metas.size() ? metas.size() : 1, sizeof *out));
         if (!out) throw std::bad_alloc();
         for (const auto& m : metas) fill_info(nano ? nullptr : &file, *m, out[n++]);
