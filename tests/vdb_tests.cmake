@@ -38,12 +38,15 @@ veil_vdb_case(limits unit)
 # a scene's VDB source: veil_scene_volume_open with err == NULL on a missing
 # and a corrupt file; veil_scene_volume_key is the file's identity, not its bytes
 veil_vdb_case(scene_volume unit)
-# native resolution: a VDB without max_resolution keeps its voxels (values copied)
-veil_vdb_case(native "unit;accuracy")
-# NanoVDB (.nvdb) files read like OpenVDB files, by the reader and `veil info`
-veil_vdb_case(nanovdb unit)
-# the resampling filter by direction: the field at the centres beats a box filter when not reducing
-veil_vdb_case(filters "unit;accuracy")
+# Importing as production makes them (tests/test_vdb_import.c): native
+# resolution (a VDB without max_resolution keeps its voxels, values copied),
+# NanoVDB and half-float files read exactly, the resampling filter by direction.
+add_executable(test_vdb_import ${CMAKE_CURRENT_SOURCE_DIR}/test_vdb_import.c ${CMAKE_CURRENT_SOURCE_DIR}/check.c)
+target_link_libraries(test_vdb_import PRIVATE veil veil_fp veil_warnings)
+foreach(case native nanovdb filters)
+  add_test(NAME vdb_${case} COMMAND test_vdb_import ${VDB_DATA} ${case})
+  set_tests_properties(vdb_${case} PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "unit;accuracy")
+endforeach()
 
 # `veil info` (tests/vdb_bad.sh VEIL EXPECTED_EXIT EXPECTED_TEXT ARGS...).
 function(veil_vdb_cli name rc text)
@@ -76,3 +79,17 @@ add_executable(test_emission ${CMAKE_CURRENT_SOURCE_DIR}/test_emission.c ${CMAKE
 target_link_libraries(test_emission PRIVATE veil veil_fp veil_warnings)
 add_test(NAME test_emission COMMAND test_emission ${VDB_DATA})
 set_tests_properties(test_emission PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "gpu;accuracy" SKIP_RETURN_CODE 77)
+
+# A vdb source's emission or temperature grid that the file lacks: exit 1 naming
+# the field and the file's grids, nothing written (tests/bad_input.sh).
+foreach(field emission temperature)
+  file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/bad_${field}_grid.json
+    "{\"camera\": {\"position\": [0, 0, 3], \"look_at\": [0, 0, 0], \"width\": 8, \"height\": 6},
+      \"medium\": {\"sigma_s\": [1, 1, 1], \"sources\": [{\"type\": \"vdb\",
+        \"file\": \"${VDB_DATA}/emissive_slab.vdb\", \"${field}\": {\"grid\": \"nope\"}}]}}\n")
+  add_test(NAME bad_input_${field}_grid
+           COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/bad_input.sh $<TARGET_FILE:veil_cli>
+                   ${CMAKE_CURRENT_BINARY_DIR}/bad_${field}_grid.json
+                   "medium.sources[0].${field}.grid: ${VDB_DATA}/emissive_slab.vdb: no grid named 'nope'")
+  set_tests_properties(bad_input_${field}_grid PROPERTIES FIXTURES_REQUIRED vdb_data LABELS bad_input)
+endforeach()
