@@ -41,52 +41,98 @@ static char* info_log(GLuint obj, int is_program)
 
 /* The shader line that pulls in an embedded header (GLSL has no #include). */
 #define VEIL__INCLUDE_MARK "//@include "
+#define VEIL__MAX_INCLUDES 8 /* files per program, nesting included */
+
+/* The text being assembled: the shader with its includes expanded in
+ * place, each followed by a #line that resumes the file it came from. */
+typedef struct veil__text {
+    char* buf;
+    size_t len, cap;
+    const char* names[VEIL__MAX_INCLUDES + 2]; /* source string k of the driver's log */
+    int count;
+} veil__text;
+
+static int text_put(veil__text* t, const char* s, size_t n)
+{
+    if (t->len + n + 1 > t->cap) {
+        size_t cap = 2 * (t->len + n + 1);
+        char* b = realloc(t->buf, cap);
+        if (!b) return 0;
+        t->buf = b, t->cap = cap;
+    }
+    memcpy(t->buf + t->len, s, n);
+    t->len += n;
+    t->buf[t->len] = 0;
+    return 1;
+}
+
+/* Appends `source` (source string number `id`), expanding its includes. */
+static veil_result expand(veil__text* t, const char* file, const char* source, int id, int depth, veil_error* err)
+{
+    if (depth > VEIL__MAX_INCLUDES)
+        return veil_fail(err, VEIL_ERR_SHADER, "%s: includes nested deeper than %d", file, VEIL__MAX_INCLUDES);
+    char line[64];
+    int n = snprintf(line, sizeof line, "\n#line 1 %d\n", id);
+    if (!text_put(t, line, (size_t)n)) return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory", file);
+    int lineno = 1;
+    for (const char* p = source; *p;) {
+        const char* eol = strchr(p, '\n');
+        size_t len = eol ? (size_t)(eol - p) + 1 : strlen(p);
+        size_t mark = strlen(VEIL__INCLUDE_MARK);
+        if (len > mark && !strncmp(p, VEIL__INCLUDE_MARK, mark)) {
+            const char* name = p + mark;
+            size_t name_len = len - mark - (eol ? 1 : 0);
+            const char* header = veil_shader_source(name, name_len);
+            if (!header)
+                return veil_fail(err, VEIL_ERR_SHADER, "%s: unknown include '%.*s'", file, (int)name_len, name);
+            if (t->count == VEIL__MAX_INCLUDES + 2)
+                return veil_fail(err, VEIL_ERR_SHADER, "%s: more than %d includes", file, VEIL__MAX_INCLUDES);
+            int sub = t->count;
+            for (int i = 0; i < veil_shader_file_count; ++i)
+                if (veil_shader_files[i].source == header) t->names[t->count++] = veil_shader_files[i].path;
+            veil_result r = expand(t, file, header, sub, depth + 1, err);
+            if (r != VEIL_OK) return r;
+            n = snprintf(line, sizeof line, "\n#line %d %d\n", lineno + 1, id);
+            if (!text_put(t, line, (size_t)n)) return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory", file);
+        } else if (!text_put(t, p, len)) {
+            return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory", file);
+        }
+        p += len;
+        ++lineno;
+    }
+    return VEIL_OK;
+}
 
 veil_result veil_gl_compute_program(const char* file, const char* source, GLuint* out, veil_error* err)
 {
     *out = 0;
-    /* Source strings: 0 = core/shared.glsl.h, 1 = the shader file, 2 = an
-     * included header; #line keeps each one's own line numbers in logs. */
-    const char* parts[8] = {"#version 450 core\n#define VEIL_GLSL 1\n#line 1 0\n", veil_shader_source("core/shared.glsl.h", 0),
-                            "\n#line 1 1\n"};
-    GLint lens[8] = {-1, -1, -1};
-    int n = 3;
-    char resume[64] = "";
-    const char* mark = strstr(source, VEIL__INCLUDE_MARK);
-    if (mark) {
-        const char* name = mark + strlen(VEIL__INCLUDE_MARK);
-        const char* eol = strchr(name, '\n');
-        size_t name_len = eol ? (size_t)(eol - name) : strlen(name);
-        const char* header = veil_shader_source(name, name_len);
-        if (!header)
-            return veil_fail(err, VEIL_ERR_SHADER, "%s: unknown include '%.*s'", file, (int)name_len, name);
-        int line = 1;
-        for (const char* c = source; c < mark; ++c) line += *c == '\n';
-        snprintf(resume, sizeof resume, "\n#line %d 1\n", line + 1);
-        parts[n] = source;
-        lens[n++] = (GLint)(mark - source);
-        parts[n] = "\n#line 1 2\n";
-        lens[n++] = -1;
-        parts[n] = header;
-        lens[n++] = -1;
-        parts[n] = resume;
-        lens[n++] = -1;
-        parts[n] = eol ? eol : "";
-        lens[n++] = -1;
-    } else {
-        parts[n] = source;
-        lens[n++] = -1;
+    /* Source strings: 0 = core/shared.glsl.h, 1 = the shader file, 2.. = its
+     * includes in the order met; #line keeps each one's own line numbers in logs. */
+    const char* parts[3] = {"#version 450 core\n#define VEIL_GLSL 1\n#line 1 0\n", veil_shader_source("core/shared.glsl.h", 0),
+                            NULL};
+    veil__text t = {.names = {"core/shared.glsl.h", file}, .count = 2};
+    veil_result res = expand(&t, file, source, 1, 0, err);
+    if (res != VEIL_OK) {
+        free(t.buf);
+        return res;
     }
+    parts[2] = t.buf;
+    int n = 3;
     GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
-    glShaderSource(sh, n, parts, lens);
+    glShaderSource(sh, n, parts, NULL);
     glCompileShader(sh);
+    free(t.buf);
     GLint ok = 0;
     glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
     if (!ok) {
         char* log = info_log(sh, 0);
-        veil_fail(err, VEIL_ERR_SHADER,
-                  "%s: compile failed (in the log, source 1 is this file, 0 core/shared.glsl.h, 2 its include):\n%s",
-                  file, log ? log : "(no log)");
+        char names[512] = "";
+        for (int i = 0; i < t.count; ++i) {
+            size_t len = strlen(names);
+            snprintf(names + len, sizeof names - len, "%s%d %s", i ? ", " : "", i, t.names[i]);
+        }
+        veil_fail(err, VEIL_ERR_SHADER, "%s: compile failed (the log's source numbers: %s):\n%s", file, names,
+                  log ? log : "(no log)");
         free(log);
         glDeleteShader(sh);
         return VEIL_ERR_SHADER;

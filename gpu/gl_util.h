@@ -14,7 +14,8 @@
 
 /* Compiles and links a compute program: "#version 450", VEIL_GLSL, the
  * shared header, then `source`, where a line `//@include NAME` is replaced
- * by the embedded file NAME (gpu/programs.h; one include per shader).
+ * by the embedded file NAME (gpu/programs.h; includes may nest, at most 8
+ * files in all).
  * `file` (e.g. "render/shaders/march.comp") names the shader in errors and
  * in the object label. Stages use veil_gpu_program(); this is for shaders
  * that are not files (tests, benchmarks). */

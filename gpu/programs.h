@@ -33,4 +33,10 @@ const char* veil_shader_source(const char* path, size_t len);
  * path is not in the registry). */
 veil_result veil_gpu_program(const char* path, GLuint* out, veil_error* err);
 
+/* The same with `defines` (e.g. "#define VEIL_SPARSE 1\n") put before the
+ * file's text: a variant of one shader (the march with emission, or over a
+ * sparse volume). The label is "PATH (variant)". */
+veil_result veil_gpu_program_variant(const char* path, const char* defines, const char* variant, GLuint* out,
+                                     veil_error* err);
+
 #endif

@@ -10,6 +10,7 @@
 
 struct veil_march {
     GLuint program, program_emission, ubo; /* the march, and its variant with emission */
+    GLuint program_sparse;                 /* over a sparse volume, made when first needed */
 };
 
 veil_result veil_march_create(veil_march** out, veil_error* err)
@@ -18,21 +19,9 @@ veil_result veil_march_create(veil_march** out, veil_error* err)
     veil_march* m = calloc(1, sizeof *m);
     if (!m) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the ray marcher");
     veil_result r = veil_gpu_program("render/shaders/march.comp", &m->program, err);
-    if (r == VEIL_OK) {
-        /* the emission variant: the same file with VEIL_MARCH_EMISSION defined */
-        const char* src = veil_shader_source("render/shaders/march.comp", 0);
-        static const char prefix[] = "#define VEIL_MARCH_EMISSION 1\n";
-        size_t n = src ? strlen(src) : 0;
-        char* text = src ? malloc(sizeof prefix + n) : NULL;
-        if (!text) {
-            r = veil_fail(err, VEIL_ERR_OOM, "out of memory for the march's emission variant");
-        } else {
-            memcpy(text, prefix, sizeof prefix - 1);
-            memcpy(text + sizeof prefix - 1, src, n + 1);
-            r = veil_gl_compute_program("render/shaders/march.comp (emission)", text, &m->program_emission, err);
-            free(text);
-        }
-    }
+    if (r == VEIL_OK) /* the emission variant: the same file with VEIL_MARCH_EMISSION defined */
+        r = veil_gpu_program_variant("render/shaders/march.comp", "#define VEIL_MARCH_EMISSION 1\n", "emission",
+                                     &m->program_emission, err);
     if (r == VEIL_OK)
         r = veil_gl_buffer(NULL, sizeof(veil_march_block), GL_DYNAMIC_STORAGE_BIT, "veil march block", &m->ubo, err);
     if (r != VEIL_OK) {
@@ -48,6 +37,7 @@ void veil_march_destroy(veil_march* m)
     if (!m) return;
     glDeleteProgram(m->program);
     glDeleteProgram(m->program_emission);
+    glDeleteProgram(m->program_sparse);
     glDeleteBuffers(1, &m->ubo);
     free(m);
 }
@@ -169,7 +159,13 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
     if (r == VEIL_OK) {
         out->width = w, out->height = h;
         glNamedBufferSubData(m->ubo, 0, sizeof u, &u);
-        glUseProgram(d->grid && d->emission ? m->program_emission : m->program);
+        if (d->grid && d->sparse && !m->program_sparse)
+            r = veil_gpu_program_variant("render/shaders/march.comp", "#define VEIL_SPARSE 1\n", "sparse",
+                                         &m->program_sparse, err);
+    }
+    if (r == VEIL_OK) {
+        glUseProgram(d->grid && d->sparse ? m->program_sparse : d->grid && d->emission ? m->program_emission : m->program);
+        veil_ev_sparse_bind(d->grid ? d->sparse : NULL);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, m->ubo);
         glBindTextureUnit(VEIL_TEX_EV, d->grid ? d->ev : 0);
         glBindTextureUnit(VEIL_TEX_OCC, d->grid ? d->occupancy : 0);
@@ -182,6 +178,7 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         for (int t = 0; t <= VEIL_TEX_EMISSION; ++t) glBindTextureUnit((GLuint)t, 0);
+        veil_ev_sparse_bind(NULL);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, 0);
         glUseProgram(0);
         r = veil_gl_check("ray march (render/shaders/march.comp)", err);
