@@ -273,3 +273,21 @@ veil_result veil__read_file(const char* path, size_t limit, const char* kind, ch
     *buf = b, *len = n;
     return VEIL_OK;
 }
+
+veil_result veil__jr_get_name(const ctx* c, const cJSON* o, const jpath* pp, const char* key,
+                               const char* const* names, int* out)
+{
+    const jpath p = {pp, key, 0};
+    char what[160] = "one of ";
+    veil__jr_join(names, true, what + 7, sizeof what - 7);
+    const cJSON* v;
+    TRY(veil__jr_lookup(c, o, &p, false, what, &v));
+    if (!v) return VEIL_OK;
+    for (int i = 0; cJSON_IsString(v) && names[i]; ++i) {
+        if (strcmp(v->valuestring, names[i]) == 0) {
+            *out = i;
+            return VEIL_OK;
+        }
+    }
+    return veil__jr_expected(c, &p, what, v);
+}

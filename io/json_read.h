@@ -66,6 +66,10 @@ veil_result veil__jr_expected(const ctx* c, const jpath* p, const char* what, co
 void veil__jr_join(const char* const* names, bool quote, char* buf, size_t n);
 veil_result veil__jr_check_keys(const ctx* c, const cJSON* obj, const jpath* p, const char* const* allowed);
 veil_result veil__jr_lookup(const ctx* c, const cJSON* obj, const jpath* p, bool required, const char* what, const cJSON** v);
+/* Optional string key whose value is one of `names` (NULL-terminated): *out
+ * = its index; left as it is when absent. */
+veil_result veil__jr_get_name(const ctx* c, const cJSON* o, const jpath* pp, const char* key,
+                              const char* const* names, int* out);
 veil_result veil__jr_get_container(const ctx* c, const cJSON* obj, const jpath* p, bool required, bool array, const cJSON** v);
 veil_result veil__jr_parse_number(const ctx* c, const cJSON* v, const jpath* p, const range* r, double* out);
 veil_result veil__jr_get_number(const ctx* c, const cJSON* obj, const jpath* pp, const char* key, bool required, const range* r, double* out);

@@ -21,7 +21,9 @@
 
 static const char* const ROOT_KEYS[] = {"camera", "medium", "lights", "background", "multiple_scattering", NULL};
 static const char* const CAMERA_KEYS[] = {"position", "look_at", "up", "fov_y_deg", "width", "height", NULL};
-static const char* const MEDIUM_KEYS[] = {"sigma_a", "sigma_s", "phase", "max_resolution", "sources", NULL};
+static const char* const MEDIUM_KEYS[] = {"sigma_a", "sigma_s", "phase", "max_resolution", "representation",
+                                           "sources", NULL};
+static const char* const REPRESENTATIONS[] = {"auto", "dense", "sparse", NULL}; /* = veil_representation */
 static const char* const PHASE_TYPES[] = {"isotropic", "hg", NULL}; /* = veil_phase_type */
 static const char* const ISO_KEYS[] = {"type", NULL};
 static const char* const HG_KEYS[] = {"type", "g", NULL};
@@ -95,6 +97,9 @@ static veil_result parse_medium(const ctx* c, const cJSON* root, veil_medium* m)
     TRY(parse_phase(c, o, &p, &m->phase));
     TRY(veil__jr_get_int(c, o, &p, "max_resolution", &VEIL__R_RES, &m->max_resolution));
     m->max_resolution_set = cJSON_GetObjectItemCaseSensitive(o, "max_resolution") != NULL;
+    int rep = (int)m->representation;
+    TRY(veil__jr_get_name(c, o, &p, "representation", REPRESENTATIONS, &rep));
+    m->representation = (veil_representation)rep;
     return veil__parse_sources(c, o, &p, m);
 }
 

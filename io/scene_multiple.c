@@ -38,24 +38,6 @@ static veil_result get_bool(const ctx* c, const cJSON* o, const jpath* pp, const
     return VEIL_OK;
 }
 
-static veil_result get_name(const ctx* c, const cJSON* o, const jpath* pp, const char* key,
-                            const char* const* names, int* out)
-{
-    const jpath p = {pp, key, 0};
-    char what[160] = "one of ";
-    veil__jr_join(names, true, what + 7, sizeof what - 7);
-    const cJSON* v;
-    TRY(veil__jr_lookup(c, o, &p, false, what, &v));
-    if (!v) return VEIL_OK;
-    for (int i = 0; cJSON_IsString(v) && names[i]; ++i) {
-        if (strcmp(v->valuestring, names[i]) == 0) {
-            *out = i;
-            return VEIL_OK;
-        }
-    }
-    return veil__jr_expected(c, &p, what, v);
-}
-
 static veil_result get_float(const ctx* c, const cJSON* o, const jpath* pp, const char* key, const range* r,
                              float* out)
 {
@@ -95,7 +77,7 @@ veil_result veil__parse_multiple(const ctx* c, const cJSON* root, veil_multiple*
     TRY(get_bool(c, o, &p, "screen_space", &m->screen_space));
     TRY(get_bool(c, o, &p, "volumetric", &m->volumetric));
     int vm = (int)m->volumetric_method;
-    TRY(get_name(c, o, &p, "volumetric_method", VOL_METHODS, &vm));
+    TRY(veil__jr_get_name(c, o, &p, "volumetric_method", VOL_METHODS, &vm));
     m->volumetric_method = (veil_volumetric_method)vm;
     TRY(veil__jr_get_int(c, o, &p, "diffusion_cells", &R_CELLS, &m->diffusion_cells));
     TRY(veil__jr_get_int(c, o, &p, "diffusion_iterations", &R_ITER, &m->diffusion_iterations));
@@ -105,11 +87,11 @@ veil_result veil__parse_multiple(const ctx* c, const cJSON* root, veil_multiple*
     TRY(get_bool(c, o, &p, "luminance_weighting", &m->luminance_weighting));
     TRY(get_bool(c, o, &p, "density_blur", &m->density_blur));
     TRY(veil__jr_get_int(c, o, &p, "levels", &R_LEVELS, &m->levels));
-    TRY(get_name(c, o, &p, "filter", FILTERS, &filter));
+    TRY(veil__jr_get_name(c, o, &p, "filter", FILTERS, &filter));
     m->filter = (veil_spread_filter)filter;
     veil_spread_default_weights(m->filter, m->weights);
     TRY(get_weights(c, o, &p, m));
-    TRY(get_name(c, o, &p, "interpolation", INTERPS, &interp));
+    TRY(veil__jr_get_name(c, o, &p, "interpolation", INTERPS, &interp));
     m->interp = (veil_spread_interp)interp;
     TRY(get_bool(c, o, &p, "separation", &m->separation));
     TRY(get_float(c, o, &p, "separation_luminance", &R_NONNEG, &m->sep_luminance));
@@ -124,7 +106,7 @@ veil_result veil__parse_multiple(const ctx* c, const cJSON* root, veil_multiple*
     TRY(get_float(c, o, &p, "k_ssc", &R_UNIT_CLOSED, &m->k_ssc));
     TRY(get_float(c, o, &p, "thin_threshold", &R_NONNEG, &m->thin_threshold));
     TRY(veil__jr_get_int(c, o, &p, "octaves", &R_OCTAVES, &m->octaves));
-    TRY(get_name(c, o, &p, "octave_gate", GATES, &m->octave_gate));
+    TRY(veil__jr_get_name(c, o, &p, "octave_gate", GATES, &m->octave_gate));
     TRY(get_float(c, o, &p, "octave_extinction", &R_UNIT_OPEN_LO, &m->octave_a));
     TRY(get_float(c, o, &p, "octave_contribution", &R_UNIT_OPEN_HI, &m->octave_b));
     return get_float(c, o, &p, "octave_eccentricity", &R_UNIT_CLOSED, &m->octave_c);

@@ -100,6 +100,15 @@ typedef struct veil_source {
 #define VEIL_FOG_DEFAULT_HALF_EXTENT 1000.0f
 /* At most VEIL_MAX_FOGS (core/shared.glsl.h) exponential fogs. */
 
+/* How the extinction volume holds a VDB's voxels (volume/sparse.h):
+ * automatic (dense when the native grid fits the dense cap, else sparse
+ * where the scene allows it), or as the user asks. */
+typedef enum veil_representation {
+    VEIL_REPRESENTATION_AUTO = 0,
+    VEIL_REPRESENTATION_DENSE,
+    VEIL_REPRESENTATION_SPARSE
+} veil_representation;
+
 typedef struct veil_medium {
     float sigma_a[3]; /* m^-1 per unit density, default 0 */
     float sigma_s[3]; /* m^-1 per unit density */
@@ -109,6 +118,7 @@ typedef struct veil_medium {
      * which applies to particles only: a VDB source then keeps its own
      * voxels (volume/scene_volume.h, "native resolution"). */
     int max_resolution_set;
+    veil_representation representation; /* medium.representation */
     veil_source* sources; /* owned */
     size_t source_count;
 } veil_medium;

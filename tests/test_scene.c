@@ -237,6 +237,8 @@ static const bad_case BAD[] = {
      "medium.max_resolution", "expected an integer in [2, 2048], got -3 (negative and zero values"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'max_resolution':4096,'sources':[]}}", VEIL_ERR_INVALID,
      "medium.max_resolution", "got 4096"},
+    {"{" CAM ",'medium':{'sigma_s':[1,1,1],'representation':'octree','sources':[]}}", VEIL_ERR_INVALID,
+     "medium.representation", "expected one of \"auto\", \"dense\", \"sparse\""},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'phase':{'type':'rayleigh'},'sources':[]}}", VEIL_ERR_INVALID,
      "medium.phase.type", "expected one of \"isotropic\", \"hg\", got a string (\"rayleigh\")"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'phase':{'type':'hg','g':1},'sources':[]}}", VEIL_ERR_INVALID,
