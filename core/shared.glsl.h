@@ -155,6 +155,38 @@ VEIL_STRUCT_BEGIN(veil_march_block)
     veil_gpu_fog fogs[VEIL_MAX_FOGS];
 VEIL_STRUCT_END(veil_march_block)
 
+/* ---- the sparse extinction volume (volume/sparse.h) --------------------- */
+
+/* A sparse EV keeps only the VEIL_BRICK^3 bricks whose interpolation cell
+ * holds density, each in an atlas with its 8 voxels and the next brick's
+ * first (VEIL_SPARSE_APRON texels a side, so hardware trilinear filtering
+ * never leaves the brick), found through two tables: a top table of nodes
+ * (VEIL_SPARSE_NODE^3 bricks, 128^3 voxels) and, per node, a table of slots. */
+#define VEIL_SPARSE_APRON 9
+#define VEIL_SPARSE_NODE 16
+#define VEIL_SPARSE_NODE_BRICKS (VEIL_SPARSE_NODE * VEIL_SPARSE_NODE * VEIL_SPARSE_NODE)
+/* The escape field of a sparse volume: a 3^3 lattice per brick (every 4
+ * voxels, its first and last texel on the brick's faces). */
+#define VEIL_SPARSE_ESCAPE 3
+/* Midpoint steps (voxels) of the optical depth marched through a sparse volume. */
+#define VEIL_SPARSE_OD_STEP 0.5
+#define VEIL_SPARSE_GROUP 4 /* 4^3 atlas texels per work group */
+#define VEIL_UBO_SPARSE 3
+#define VEIL_TEX_SPARSE_TOP 9     /* texture unit: r32ui buffer, the top table (0: empty node, else node + 1) */
+#define VEIL_TEX_SPARSE_NODES 10  /* texture unit: r32ui buffer, the nodes' tables (0: empty brick, else slot + 1) */
+#define VEIL_TEX_SPARSE_COORDS 11 /* texture unit: rgba32i buffer, each slot's brick */
+#define VEIL_TEX_SPARSE_ESCAPE 12 /* texture unit: r32f 3D, the escape field per brick */
+#define VEIL_IMAGE_SPARSE_OUT 0   /* image unit: what a sparse pass writes (atlas-shaped) */
+
+VEIL_STRUCT_BEGIN(veil_sparse_block)
+    VEIL_IV4(bricks);    /* xyz: bricks of the grid; w: slots in use */
+    VEIL_IV4(top);       /* xyz: nodes of the top table; w: - */
+    VEIL_IV4(atlas);     /* xyz: the atlas in bricks; w: - */
+    VEIL_V4(origin);     /* xyz: the grid's min corner (m); w: voxel edge (m) */
+    VEIL_V4(inv_atlas);  /* xyz: 1 / atlas texels per axis; w: - */
+    VEIL_V4(dims);       /* xyz: the grid's voxels per axis (float); w: - */
+VEIL_STRUCT_END(veil_sparse_block)
+
 /* ---- screen-space multiple scattering (render/spread.h) ---------------- */
 
 #define VEIL_SPREAD_GROUP 8     /* 8x8 pixels per work group, every spread pass */

@@ -163,10 +163,19 @@ static veil_result inject_scene(veil_renderer* r, const veil_scene* s, veil_rend
             why(rep, "the sources hold no density (no particle, no active voxel)");
         } else {
             const veil_grid* g = &v.grid;
+            const veil_ev_sparse* sp = veil_ev_sparse_of(r->ev);
+            char mem[200];
+            if (sp)
+                snprintf(mem, sizeof mem, "; %zu bricks kept of %.0f (%.0fx%.0fx%.0f), %.1f MiB on the GPU (dense: %.0f MiB)",
+                         sp->slots, ceil(g->dims[0] / 8.0) * ceil(g->dims[1] / 8.0) * ceil(g->dims[2] / 8.0),
+                         ceil(g->dims[0] / 8.0), ceil(g->dims[1] / 8.0), ceil(g->dims[2] / 8.0),
+                         (double)er.bytes / 1048576.0, (double)g->dims[0] * g->dims[1] * g->dims[2] * 4 / 1048576.0);
+            else
+                snprintf(mem, sizeof mem, "; %.1f MiB on the GPU", (double)er.bytes / 1048576.0);
             rep->status = VEIL_STAGE_RAN;
-            why(rep, "%s: %zu particles, %zu VDB voxels, grid %dx%dx%d, voxel %.4g m (%s)",
+            why(rep, "%s: %zu particles, %zu VDB voxels, grid %dx%dx%d, voxel %.4g m (%s%s)",
                 had ? "the sources changed" : "no volume kept", er.particles, er.vdb_voxels, g->dims[0], g->dims[1],
-                g->dims[2], g->voxel, v.resolution);
+                g->dims[2], g->voxel, v.resolution, mem);
         }
     }
     veil_scene_volume_close(&v);
@@ -201,7 +210,9 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
     }
     veil_opv_params params = veil_render_opv_params(s, o->method);
     veil_opv_report orep = {0};
-    veil_result res = veil_opv_set_update(r->opv, g, veil_ev_texture(r->ev), r->ev_key, lights, n, &params, &orep, err);
+    const veil_ev_sparse* sp = veil_ev_sparse_of(r->ev);
+    veil_result res = veil_opv_set_update_ev(r->opv, g, veil_ev_texture(r->ev), sp, r->ev_key, lights, n, &params,
+                                             &orep, err);
     st->opv_computed = orep.computed;
     st->opv_cached = orep.cached;
     st->propagate_iterations = orep.iterations;
@@ -212,12 +223,12 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
         rep->key = veil_hash_bytes(rep->key, &ol, sizeof ol);
     }
     rep->status = orep.computed ? VEIL_STAGE_RAN : VEIL_STAGE_CACHED;
+    const char* method = sp ? "marched per kept voxel (sparse)" : veil_opv_method_name(o->method);
     if (orep.computed)
         why(rep, "%d of %zu lights, %s, %d passes; %d textures computed (volume or light moved), %d cached", n,
-            s->light_count, veil_opv_method_name(o->method), orep.iterations, orep.computed, orep.cached);
+            s->light_count, method, orep.iterations, orep.computed, orep.cached);
     else
-        why(rep, "%d lights, %s: the volume, method and lights' geometry are unchanged", n,
-            veil_opv_method_name(o->method));
+        why(rep, "%d lights, %s: the volume, method and lights' geometry are unchanged", n, method);
     return res;
 }
 
@@ -257,7 +268,11 @@ static veil_result diffuse(veil_renderer* r, const veil_scene* s, const veil_mar
                                                                         : (float)VEIL_FIELD_FLUENCE, field, &dr, err);
     if (res != VEIL_OK) return res;
     rep->key = key;
-    if (dr.skipped) {
+    if (dr.skipped && dr.sparse) {
+        rep->status = VEIL_STAGE_SKIPPED;
+        why(rep, "the diffusion solve needs a dense grid; over a sparse volume there is no volumetric estimate "
+                 "(set multiple_scattering.volumetric_method to \"octave\")");
+    } else if (dr.skipped) {
         rep->status = VEIL_STAGE_SKIPPED;
         why(rep, "no grid: no medium, or a fog box over %g m%s", VEIL_DIFFUSION_MAX_EXTENT,
             escape ? " (the octaves fall back to the legs gate)" : "");
@@ -266,7 +281,10 @@ static veil_result diffuse(veil_renderer* r, const veil_scene* s, const veil_mar
         why(rep, "the volume, lights and medium are unchanged (%dx%dx%d cells)", dr.dims[0], dr.dims[1], dr.dims[2]);
     } else {
         rep->status = VEIL_STAGE_RAN;
-        if (escape)
+        if (escape && dr.sparse)
+            why(rep, "the octaves' escape field, %d points a kept brick (every %.4g m): view- and light-independent, "
+                "kept", VEIL_SPARSE_ESCAPE * VEIL_SPARSE_ESCAPE * VEIL_SPARSE_ESCAPE, dr.cell);
+        else if (escape)
             why(rep, "the octaves' escape field, %dx%dx%d cells of %.4g m: view- and light-independent, kept",
                 dr.dims[0], dr.dims[1], dr.dims[2], dr.cell);
         else
@@ -358,6 +376,7 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
     veil_march_desc md = {.scene = s, .camera = o->camera, .width = o->width, .height = o->height,
                           .lights = lights, .light_count = n, .grid = g,
                           .ev = veil_ev_texture(r->ev), .occupancy = veil_ev_occupancy(r->ev),
+                          .sparse = veil_ev_sparse_of(r->ev),
                           .emission = veil_ev_emission(r->ev), .opv = opv,
                           .step_voxels = o->step_voxels, .seed = o->seed, .skip_empty = !o->no_skip,
                           .max_distance = o->max_distance, .end_distance = o->behind_distance,

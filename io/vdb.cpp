@@ -434,6 +434,25 @@ veil_result veil_vdb_dense(const veil_vdb* v, const int lo[3], const int hi[3], 
     });
 }
 
+veil_result veil_vdb_each_voxel(const veil_vdb* v, veil_vdb_voxel_fn fn, void* user, veil_error* err)
+{
+    if (!v || !fn) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_each_voxel: missing argument");
+    return guarded(err, v->path.c_str(), [&] {
+        for (auto it = v->grid->cbeginValueOn(); it; ++it) {
+            float value = *it;
+            if (value == 0.0f) continue;
+            CoordBBox box;
+            it.getBoundingBox(box); // one voxel, or an active tile's voxels
+            for (int z = box.min()[2]; z <= box.max()[2]; ++z)
+                for (int y = box.min()[1]; y <= box.max()[1]; ++y)
+                    for (int x = box.min()[0]; x <= box.max()[0]; ++x) {
+                        const int ijk[3] = {x, y, z};
+                        fn(user, ijk, value);
+                    }
+        }
+    });
+}
+
 veil_result veil_vdb_file_info(const char* path, veil_vdb_grid_info** grids, size_t* count, veil_error* err)
 {
     if (!path || !grids || !count) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_file_info: missing argument");

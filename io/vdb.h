@@ -83,6 +83,13 @@ veil_result veil_vdb_sample_world(const veil_vdb* v, const double* xyz, size_t n
  * not fit in size_t. */
 veil_result veil_vdb_dense(const veil_vdb* v, const int lo[3], const int hi[3], float* out);
 
+/* Calls fn(user, ijk, value) for every active voxel of the grid whose value
+ * is not 0 (an active tile's voxels one by one), leaf by leaf in the tree's
+ * order, which depends only on the file. The caller bounds the work with
+ * the active count of veil_vdb_index_bbox first. */
+typedef void (*veil_vdb_voxel_fn)(void* user, const int ijk[3], float value);
+veil_result veil_vdb_each_voxel(const veil_vdb* v, veil_vdb_voxel_fn fn, void* user, veil_error* err);
+
 /* One grid of a file, as `veil info` shows it. */
 typedef struct veil_vdb_grid_info {
     char* name;            /* owned */

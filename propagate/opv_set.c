@@ -5,11 +5,14 @@
 
 #include "../core/hash.h"
 #include "../gpu/gl_util.h"
+#include "../gpu/programs.h"
 #include "opv_gpu.h"
 
 struct veil_opv_set {
     veil_opv_programs programs;
+    GLuint sparse_program; /* propagate/shaders/propagate_sparse.comp, made when first needed */
     GLuint tex[VEIL_MAX_OPV_TEXTURES];
+    int dims[VEIL_MAX_OPV_TEXTURES][3];
     uint64_t key[VEIL_MAX_OPV_TEXTURES]; /* 0: none (or being remade) */
 };
 
@@ -31,6 +34,7 @@ void veil_opv_set_clear(veil_opv_set* s)
 {
     glDeleteTextures(VEIL_MAX_OPV_TEXTURES, s->tex);
     memset(s->tex, 0, sizeof s->tex);
+    memset(s->dims, 0, sizeof s->dims);
     memset(s->key, 0, sizeof s->key);
 }
 
@@ -38,6 +42,7 @@ void veil_opv_set_destroy(veil_opv_set* s)
 {
     if (!s) return;
     veil_opv_set_clear(s);
+    glDeleteProgram(s->sparse_program);
     veil_opv_programs_destroy(&s->programs);
     free(s);
 }
@@ -53,9 +58,61 @@ uint64_t veil_opv_texture_key(uint64_t ev_key, const veil_opv_params* params, co
 
 int veil_opv_set_has(const veil_opv_set* s, int t, uint64_t key) { return s->tex[t] && s->key[t] == key; }
 
+/* Texture t of dims (kept when it has them already). */
+static veil_result texture_of(veil_opv_set* s, int t, const int dims[3], const char* label, veil_error* err)
+{
+    if (s->tex[t] && !memcmp(s->dims[t], dims, sizeof s->dims[t])) return VEIL_OK;
+    glDeleteTextures(1, &s->tex[t]);
+    s->tex[t] = 0;
+    memset(s->dims[t], 0, sizeof s->dims[t]);
+    veil_result r = veil_gl_texture3d(GL_RGBA32F, dims, label, &s->tex[t], err);
+    if (r == VEIL_OK) memcpy(s->dims[t], dims, sizeof s->dims[t]);
+    return r;
+}
+
+/* Texture t over a sparse volume: propagate/shaders/propagate_sparse.comp. */
+static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, const veil_grid* g,
+                                 const veil_opv_light* ol, int count, GLuint tex, veil_error* err)
+{
+    veil_result r = VEIL_OK;
+    if (!s->sparse_program) r = veil_gpu_program("propagate/shaders/propagate_sparse.comp", &s->sparse_program, err);
+    if (r != VEIL_OK) return r;
+    GLuint p = s->sparse_program;
+    float lights[16] = {0};
+    for (int c = 0; c < count; ++c) {
+        /* opv.h's index space has voxel i's centre at i; the sparse one at i + 0.5 */
+        float shift = ol[c].type == VEIL_LIGHT_DIRECTIONAL ? 0.0f : 0.5f;
+        for (int a = 0; a < 3; ++a) lights[4 * c + a] = ol[c].v[a] + shift;
+        lights[4 * c + 3] = (float)ol[c].type;
+    }
+    (void)g;
+    glUseProgram(p);
+    glProgramUniform4fv(p, glGetUniformLocation(p, "u_light"), 4, lights);
+    glProgramUniform1i(p, glGetUniformLocation(p, "u_count"), count);
+    veil_ev_sparse_bind(sp);
+    glBindTextureUnit(VEIL_TEX_EV, sp->atlas);
+    glBindImageTexture(VEIL_IMAGE_SPARSE_OUT, tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glDispatchCompute(veil_groups(sp->atlas_texels[0], VEIL_SPARSE_GROUP),
+                      veil_groups(sp->atlas_texels[1], VEIL_SPARSE_GROUP),
+                      veil_groups(sp->atlas_texels[2], VEIL_SPARSE_GROUP));
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    glBindImageTexture(VEIL_IMAGE_SPARSE_OUT, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindTextureUnit(VEIL_TEX_EV, 0);
+    veil_ev_sparse_bind(NULL);
+    glUseProgram(0);
+    return veil_gl_check("optical depth over a sparse volume (propagate/shaders/propagate_sparse.comp)", err);
+}
+
 veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, uint64_t ev_key,
                                 const veil_light* lights, int n, const veil_opv_params* params, veil_opv_report* rep,
                                 veil_error* err)
+{
+    return veil_opv_set_update_ev(s, g, ev, NULL, ev_key, lights, n, params, rep, err);
+}
+
+veil_result veil_opv_set_update_ev(veil_opv_set* s, const veil_grid* g, GLuint ev, const veil_ev_sparse* sp,
+                                   uint64_t ev_key, const veil_light* lights, int n, const veil_opv_params* params,
+                                   veil_opv_report* rep, veil_error* err)
 {
     memset(rep, 0, sizeof *rep);
     veil_result r = VEIL_OK;
@@ -68,10 +125,11 @@ veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, 
             ++rep->cached;
             continue;
         }
-        if (!s->tex[t]) r = veil_gl_texture3d(GL_RGBA32F, g->dims, "veil optical-depth volume", &s->tex[t], err);
-        int it = 0;
+        r = texture_of(s, t, sp ? sp->atlas_texels : g->dims, sp ? "veil optical depth (sparse atlas)" : "veil optical-depth volume", err);
+        int it = sp ? 1 : 0;
         s->key[t] = 0;
-        if (r == VEIL_OK) r = veil_opv_gpu(&s->programs, g, ev, ol, count, params, &s->tex[t], &it, err);
+        if (r == VEIL_OK && sp) r = sparse_depths(s, sp, g, ol, count, s->tex[t], err);
+        else if (r == VEIL_OK) r = veil_opv_gpu(&s->programs, g, ev, ol, count, params, &s->tex[t], &it, err);
         if (r == VEIL_OK) s->key[t] = key;
         rep->iterations = it > rep->iterations ? it : rep->iterations;
         ++rep->computed;

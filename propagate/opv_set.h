@@ -15,6 +15,7 @@
 #include <stdint.h>
 
 #include "../core/result.h"
+#include "../volume/ev.h"
 #include "opv.h"
 
 typedef struct veil_opv_set veil_opv_set;
@@ -43,6 +44,14 @@ int veil_opv_set_has(const veil_opv_set* s, int t, uint64_t key);
 veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, uint64_t ev_key,
                                 const veil_light* lights, int n, const veil_opv_params* params,
                                 veil_opv_report* rep, veil_error* err);
+
+/* The same over an EV that may be sparse (sp: veil_ev_sparse_of, NULL for
+ * dense): a sparse EV's textures are atlases laid out like its density's,
+ * each texel's optical depth marched to the light
+ * (propagate/shaders/propagate_sparse.comp; `params` only keys it). */
+veil_result veil_opv_set_update_ev(veil_opv_set* s, const veil_grid* g, GLuint ev, const veil_ev_sparse* sp,
+                                   uint64_t ev_key, const veil_light* lights, int n, const veil_opv_params* params,
+                                   veil_opv_report* rep, veil_error* err);
 
 /* Texture t (0 when none): VEIL_MAX_OPV_TEXTURES of them. */
 GLuint veil_opv_set_texture(const veil_opv_set* s, int t);

@@ -10,6 +10,9 @@
 
 struct veil_diffusion {
     GLuint source_program, sor_program, escape_program, ubo, march_ubo;
+    GLuint escape_sparse_program; /* escape.comp over a sparse volume, made when first needed */
+    float cell;                   /* the kept field's cell (m), for the report */
+    int sparse;                   /* ... and whether it is over a sparse volume */
     GLuint src, phi;    /* 3D textures of the kept field (0: none) */
     int dims[3];
     veil_diffusion_field field;
@@ -57,6 +60,7 @@ void veil_diffusion_destroy(veil_diffusion* d)
     glDeleteProgram(d->source_program);
     glDeleteProgram(d->sor_program);
     glDeleteProgram(d->escape_program);
+    glDeleteProgram(d->escape_sparse_program);
     glDeleteBuffers(1, &d->ubo);
     glDeleteBuffers(1, &d->march_ubo);
     free(d);
@@ -105,6 +109,44 @@ static veil_result texture3d(const int dims[3], const char* label, GLuint* tex, 
     return veil_gl_check(label, err);
 }
 
+/* The escape field of a sparse volume: VEIL_SPARSE_ESCAPE^3 points a kept
+ * brick, in an atlas laid out like the density's (render/shaders/escape.comp
+ * with VEIL_SPARSE). */
+static veil_result escape_sparse(veil_diffusion* d, const veil_march_desc* md, int dims[3], veil_error* err)
+{
+    const veil_ev_sparse* sp = md->sparse;
+    veil_result r = VEIL_OK;
+    if (!d->escape_sparse_program)
+        r = veil_gpu_program_variant("render/shaders/escape.comp", "#define VEIL_SPARSE 1\n", "sparse",
+                                     &d->escape_sparse_program, err);
+    veil_march_block mu;
+    if (r == VEIL_OK) r = veil_march_block_fill(md, &mu, err);
+    for (int a = 0; a < 3; ++a) dims[a] = VEIL_SPARSE_ESCAPE * sp->block.atlas[a];
+    if (r == VEIL_OK) r = texture3d(dims, "veil escape field (sparse atlas)", &d->phi, err);
+    if (r != VEIL_OK) return r;
+    veil_diffusion_block u;
+    memset(&u, 0, sizeof u);
+    for (int a = 0; a < 3; ++a) u.dims[a] = dims[a];
+    glNamedBufferSubData(d->march_ubo, 0, sizeof mu, &mu);
+    glNamedBufferSubData(d->ubo, 0, sizeof u, &u);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, d->march_ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_DIFFUSION, d->ubo);
+    glUseProgram(d->escape_sparse_program);
+    veil_ev_sparse_bind(sp);
+    glBindTextureUnit(VEIL_TEX_EV, sp->atlas);
+    glBindImageTexture(VEIL_IMAGE_DIFF_PHI, d->phi, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glDispatchCompute(veil_groups(dims[0], VEIL_DIFFUSION_GROUP), veil_groups(dims[1], VEIL_DIFFUSION_GROUP),
+                      veil_groups(dims[2], VEIL_DIFFUSION_GROUP));
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glBindImageTexture(VEIL_IMAGE_DIFF_PHI, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindTextureUnit(VEIL_TEX_EV, 0);
+    veil_ev_sparse_bind(NULL);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, 0);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_DIFFUSION, 0);
+    glUseProgram(0);
+    return veil_gl_check("escape field over a sparse volume (render/shaders/escape.comp)", err);
+}
+
 veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, uint64_t key, float kind,
                                   veil_diffusion_field* field, veil_diffusion_report* rep, veil_error* err)
 {
@@ -115,7 +157,8 @@ veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, 
         rep->cached = 1;
         rep->skipped = d->phi == 0;
         memcpy(rep->dims, d->dims, sizeof rep->dims);
-        rep->cell = d->field.texture ? 1.0f / (d->field.tex_inv[0] * (float)d->dims[0]) : 0.0f;
+        rep->cell = d->cell;
+        rep->sparse = d->sparse;
         return VEIL_OK;
     }
     veil_diffusion_clear(d);
@@ -124,6 +167,29 @@ veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, 
     float lo[3], h;
     int dims[3];
     int escape = kind == (float)VEIL_FIELD_ESCAPE;
+    if (md->grid && md->sparse) {
+        rep->sparse = 1;
+        d->sparse = 1, d->cell = 0.0f;
+        if (!escape) { /* the diffusion solve needs a dense grid: no field */
+            d->keyed = 1, d->key = key;
+            rep->skipped = 1;
+            return VEIL_OK;
+        }
+        veil_result r = escape_sparse(d, md, dims, err);
+        if (r != VEIL_OK) {
+            veil_diffusion_clear(d);
+            return r;
+        }
+        memcpy(d->dims, dims, sizeof dims);
+        d->field.texture = d->phi;
+        d->field.kind = kind;
+        d->keyed = 1, d->key = key;
+        *field = d->field;
+        memcpy(rep->dims, dims, sizeof rep->dims);
+        rep->cell = d->cell = 0.5f * (float)VEIL_BRICK * md->grid->voxel;
+        d->sparse = 1;
+        return VEIL_OK;
+    }
     if (!grid_of(md, escape ? VEIL_ESCAPE_CELLS : ms->diffusion_cells, lo, &h, dims)) {
         d->keyed = 1, d->key = key;
         rep->skipped = 1;
@@ -206,7 +272,8 @@ veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, 
     d->keyed = 1, d->key = key;
     *field = d->field;
     memcpy(rep->dims, dims, sizeof rep->dims);
-    rep->cell = h;
+    rep->cell = d->cell = h;
+    d->sparse = 0;
     rep->iterations = sweeps;
     return VEIL_OK;
 }

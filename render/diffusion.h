@@ -35,7 +35,8 @@ typedef struct veil_diffusion_report {
     float cell;      /* m */
     int iterations;  /* red-black sweeps */
     int cached;      /* 1: the key matched what was kept */
-    int skipped;     /* 1: no grid (no medium, or a fog box too large) */
+    int skipped;     /* 1: no grid (no medium, or a fog box too large; the diffusion solve over a sparse volume) */
+    int sparse;      /* 1: over a sparse volume (the escape field per kept brick, 3^3 points each) */
     uint64_t key;
 } veil_diffusion_report;
 

@@ -15,6 +15,7 @@
 
 #include "../core/result.h"
 #include "../scene/scene.h"
+#include "../volume/ev.h"
 #include "../volume/volume.h"
 #include "image_set.h"
 
@@ -47,6 +48,8 @@ typedef struct veil_march_desc {
     int light_count;
     const veil_grid* grid;     /* NULL: no volume (fog only) */
     GLuint ev, occupancy;      /* the EV's textures when grid is set */
+    const veil_ev_sparse* sparse; /* a sparse EV (ev is then its atlas, occupancy 0; the optical depths and
+                                     the escape field are atlases too); NULL: dense */
     GLuint emission;           /* the EV's emission texture (0: none) */
     const GLuint* opv;         /* VEIL_MAX_OPV_TEXTURES textures (0 where unused) */
     float step_voxels;         /* > 0 */

@@ -11,7 +11,8 @@ struct veil_ev {
     GLuint inject, occupancy; /* programs */
     GLuint tex, occ;          /* the volume and its occupancy bricks */
     GLuint emission;          /* rgba32f emission (0: none) */
-    int present;
+    int present, is_sparse;
+    veil_ev_sparse sparse;
     veil_grid grid;
 };
 
@@ -37,6 +38,93 @@ void veil_ev_clear(veil_ev* ev)
     glDeleteTextures(1, &ev->emission);
     ev->tex = ev->occ = ev->emission = 0;
     ev->present = 0;
+    if (ev->is_sparse) {
+        veil_ev_sparse* sp = &ev->sparse;
+        glDeleteTextures(1, &sp->top);
+        glDeleteTextures(1, &sp->nodes);
+        glDeleteTextures(1, &sp->coords);
+        glDeleteBuffers(3, sp->buffers);
+        glDeleteBuffers(1, &sp->ubo);
+        memset(sp, 0, sizeof *sp);
+        ev->is_sparse = 0;
+    }
+}
+
+const veil_ev_sparse* veil_ev_sparse_of(const veil_ev* ev) { return ev->present && ev->is_sparse ? &ev->sparse : NULL; }
+
+void veil_ev_sparse_bind(const veil_ev_sparse* sp)
+{
+    glBindTextureUnit(VEIL_TEX_SPARSE_TOP, sp ? sp->top : 0);
+    glBindTextureUnit(VEIL_TEX_SPARSE_NODES, sp ? sp->nodes : 0);
+    glBindTextureUnit(VEIL_TEX_SPARSE_COORDS, sp ? sp->coords : 0);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_SPARSE, sp ? sp->ubo : 0);
+}
+
+/* A buffer texture of n texels of `format` (bytes a texel) from data. */
+static veil_result buffer_texture(GLenum format, size_t bytes, const void* data, const char* label, GLuint* buf,
+                                  GLuint* tex, veil_error* err)
+{
+    GLint max_texels = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+    size_t texel = format == GL_RGBA32I ? 16 : 4;
+    if (bytes / texel > (size_t)max_texels)
+        return veil_fail(err, VEIL_ERR_LIMIT, "%s: %zu entries, over this device's %d for a buffer texture", label,
+                         bytes / texel, max_texels);
+    veil_result r = veil_gl_buffer(bytes ? data : NULL, bytes ? bytes : texel, 0, label, buf, err);
+    if (r != VEIL_OK) return r;
+    glCreateTextures(GL_TEXTURE_BUFFER, 1, tex);
+    glTextureBuffer(*tex, format, *buf);
+    glObjectLabel(GL_TEXTURE, *tex, -1, label);
+    return veil_gl_check(label, err);
+}
+
+/* The sparse EV of v (v->sparse): built on the CPU (volume/sparse.c), uploaded. */
+static veil_result build_sparse(veil_ev* ev, const veil_scene_volume* v, int n_lights, unsigned long long budget,
+                                veil_error* err)
+{
+    GLint max3d = 0;
+    glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3d);
+    veil_sparse s;
+    veil_result r = veil_sparse_build(v, max3d, &s, err);
+    if (r != VEIL_OK) return r;
+    veil_ev_sparse* sp = &ev->sparse;
+    ev->is_sparse = 1;
+    veil_sparse_atlas_texels(&s, sp->atlas_texels);
+    size_t texels = (size_t)sp->atlas_texels[0] * (size_t)sp->atlas_texels[1] * (size_t)sp->atlas_texels[2];
+    /* the optical depths: an rgba32f atlas per 4 lights (veil_ev_check_budget's count for dense) */
+    unsigned long long total = veil_sparse_bytes(&s) + (unsigned long long)texels * 16 * (unsigned long long)((n_lights + 3) / 4);
+    if (total > budget)
+        r = veil_fail(err, VEIL_ERR_LIMIT,
+                      "a sparse volume of %zu bricks with %d lights needs %.0f MiB of textures, more than the %.0f MiB "
+                      "allowed on this device; set medium.max_resolution", s.count, n_lights,
+                      (double)total / 1048576.0, (double)budget / 1048576.0);
+    if (r == VEIL_OK) r = veil_gl_texture3d(GL_R32F, sp->atlas_texels, "veil sparse atlas", &ev->tex, err);
+    if (r == VEIL_OK) {
+        glTextureSubImage3D(ev->tex, 0, 0, 0, 0, sp->atlas_texels[0], sp->atlas_texels[1], sp->atlas_texels[2], GL_RED,
+                            GL_FLOAT, s.texels);
+        r = veil_gl_check("uploading the sparse atlas", err);
+    }
+    size_t top = (size_t)s.top[0] * (size_t)s.top[1] * (size_t)s.top[2];
+    if (r == VEIL_OK)
+        r = buffer_texture(GL_R32UI, top * 4, s.top_table, "veil sparse top table", &sp->buffers[0], &sp->top, err);
+    if (r == VEIL_OK)
+        r = buffer_texture(GL_R32UI, s.node_count * VEIL_SPARSE_NODE_BRICKS * 4, s.nodes, "veil sparse nodes",
+                           &sp->buffers[1], &sp->nodes, err);
+    if (r == VEIL_OK)
+        r = buffer_texture(GL_RGBA32I, s.count * 16, s.coords, "veil sparse bricks", &sp->buffers[2], &sp->coords, err);
+    veil_sparse_block_fill(&s, &sp->block);
+    if (r == VEIL_OK)
+        r = veil_gl_buffer(&sp->block, sizeof sp->block, 0, "veil sparse block", &sp->ubo, err);
+    sp->atlas = ev->tex;
+    sp->slots = s.count;
+    sp->bytes = veil_sparse_bytes(&s);
+    sp->voxels = s.voxels;
+    if (r == VEIL_OK) {
+        ev->grid = v->grid;
+        ev->present = 1;
+    }
+    veil_sparse_free(&s);
+    return r;
 }
 
 void veil_ev_destroy(veil_ev* ev)
@@ -125,6 +213,14 @@ veil_result veil_ev_build_scene(veil_ev* ev, const veil_scene_volume* v, int n_l
         return VEIL_OK;
     }
     const veil_grid* g = &v->grid;
+    if (v->sparse) {
+        veil_ev_clear(ev);
+        veil_result r = build_sparse(ev, v, n_lights, budget, err);
+        if (r != VEIL_OK) veil_ev_clear(ev);
+        rep->vdb_voxels = v->vdb_voxels;
+        rep->bytes = r == VEIL_OK ? ev->sparse.bytes : 0;
+        return r;
+    }
     veil_rbf_bins bins = {0};
     float* density = NULL;
     veil_result r = make(ev, g, n_lights, budget, err);
@@ -154,6 +250,11 @@ veil_result veil_ev_build_scene(veil_ev* ev, const veil_scene_volume* v, int n_l
     veil_rbf_bins_free(&bins);
     rep->particles = n;
     rep->vdb_voxels = v->vdb_voxels;
+    if (r == VEIL_OK) {
+        size_t b = 1;
+        for (int a = 0; a < 3; ++a) b *= (size_t)((g->dims[a] + VEIL_BRICK - 1) / VEIL_BRICK);
+        rep->bytes = veil_grid_voxels(g) * (ev->emission ? 20 : 4) + b * 4;
+    }
     return r;
 }
 

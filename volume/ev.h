@@ -4,8 +4,10 @@
  * unitless; sigma_t = (sigma_a + sigma_s) * density, m^-1) and its
  * occupancy bricks (volume/shaders/occupancy.comp: the largest density in
  * each VEIL_BRICK^3 brick and the voxel ring around it, so the marcher may
- * skip bricks without density). A sparse layout can come in behind the same
- * calls. The handle owns its textures and programs and needs the GL context
+ * skip bricks without density). Or it is sparse (volume/sparse.h: a scene
+ * volume with v->sparse): an atlas of the bricks that hold density and the
+ * tables that find them, behind the same calls (veil_ev_texture is then
+ * the atlas, veil_ev_occupancy 0, and veil_ev_sparse_of says the rest). The handle owns its textures and programs and needs the GL context
  * that was current when it was created; it does not know about caching:
  * frame/ decides when to rebuild it (the key is the caller's).
  */
@@ -17,6 +19,7 @@
 
 #include "../core/result.h"
 #include "scene_volume.h"
+#include "sparse.h"
 #include "volume.h"
 
 typedef struct veil_ev veil_ev;
@@ -25,7 +28,27 @@ typedef struct veil_ev veil_ev;
 typedef struct veil_ev_report {
     size_t particles;  /* RBF particles splatted */
     size_t vdb_voxels; /* active voxels of the OpenVDB grids resampled */
+    size_t bytes;      /* GPU bytes of the volume (texture and occupancy, or atlas and tables) */
 } veil_ev_report;
+
+/* A sparse EV's GPU objects. */
+typedef struct veil_ev_sparse {
+    GLuint atlas;              /* r32f 3D: the kept bricks' texels (also veil_ev_texture) */
+    GLuint top, nodes, coords; /* buffer textures: r32ui, r32ui, rgba32i (core/shared.glsl.h) */
+    GLuint buffers[3];         /* their storage */
+    GLuint ubo;                /* veil_sparse_block */
+    veil_sparse_block block;
+    int atlas_texels[3];
+    size_t slots;              /* bricks kept */
+    size_t bytes;              /* GPU bytes of all of the above */
+    size_t voxels;             /* non-zero voxels copied */
+} veil_ev_sparse;
+
+/* NULL for a dense EV (or none). */
+const veil_ev_sparse* veil_ev_sparse_of(const veil_ev* ev);
+/* Binds the tables (VEIL_TEX_SPARSE_TOP, _NODES, _COORDS) and the block
+ * (VEIL_UBO_SPARSE) for a pass; NULL unbinds them. */
+void veil_ev_sparse_bind(const veil_ev_sparse* sp);
 
 veil_result veil_ev_create(veil_ev** out, veil_error* err); /* compiles the inject and occupancy programs */
 void veil_ev_destroy(veil_ev* ev);                          /* accepts NULL */

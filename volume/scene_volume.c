@@ -9,6 +9,7 @@
 
 #include "../core/hash.h"
 #include "blackbody.h"
+#include "sparse.h"
 #include "vdb_volume.h"
 
 void veil_scene_volume_close(veil_scene_volume* v)
@@ -180,6 +181,7 @@ uint64_t veil_scene_volume_key(const veil_scene* s)
 {
     uint64_t k = veil_hash_bytes(VEIL_FNV_OFFSET, &s->medium.max_resolution, sizeof s->medium.max_resolution);
     k = veil_hash_bytes(k, &s->medium.max_resolution_set, sizeof s->medium.max_resolution_set);
+    k = veil_hash_bytes(k, &s->medium.representation, sizeof s->medium.representation);
     for (size_t i = 0; i < s->medium.source_count; ++i) {
         const veil_source* src = &s->medium.sources[i];
         if (src->type == VEIL_SOURCE_EXPONENTIAL) continue; /* never voxelised */
@@ -226,7 +228,7 @@ int veil_scene_volume_needed(const veil_scene* s)
 /* The native grid over [lo, hi] (module comment in scene_volume.h): 1 when
  * it applies (and *g, note are set), 0 to fit to max_resolution instead. */
 static int native_grid(const veil_scene_volume* v, const float lo[3], const float hi[3], veil_grid* g, char* note,
-                       size_t note_len)
+                       size_t note_len, int big)
 {
     double edge = HUGE_VAL, origin[3] = {0, 0, 0};
     int aligned = 0, which = -1;
@@ -251,16 +253,16 @@ static int native_grid(const veil_scene_volume* v, const float lo[3], const floa
         double i0 = floor(((double)lo[a] - base) / edge + VEIL_VDB_ALIGN_TOL);
         double i1 = ceil(((double)hi[a] - base) / edge - VEIL_VDB_ALIGN_TOL);
         double d = fmax(i1 - i0 + 1.0, 2.0);
-        if (d > VEIL_SCENE_MAX_RESOLUTION) {
-            snprintf(note, note_len, "resampled: the VDB's %.4g m voxels make %.0f along an axis (at most %d)", edge, d,
-                     VEIL_SCENE_MAX_RESOLUTION);
+        if (d > (big ? VEIL_SPARSE_MAX_SIDE : VEIL_SCENE_MAX_RESOLUTION)) {
+            snprintf(note, note_len, "resampled: the VDB's %.4g m voxels make %.0f along an axis (at most %d%s)", edge, d,
+                     big ? VEIL_SPARSE_MAX_SIDE : VEIL_SCENE_MAX_RESOLUTION, big ? ", sparse" : "");
             return 0;
         }
         dims[a] = (int)d;
         org[a] = base + (i0 - 0.5) * edge;
         n *= d;
     }
-    if (n > (double)VEIL_NATIVE_MAX_VOXELS) {
+    if (n > (double)VEIL_NATIVE_MAX_VOXELS && !big) {
         snprintf(note, note_len, "resampled: the VDB's %.4g m voxels make a %dx%dx%d grid, over the dense cap of "
                  "%zu voxels", edge, dims[0], dims[1], dims[2], (size_t)VEIL_NATIVE_MAX_VOXELS);
         return 0;
@@ -276,19 +278,82 @@ static int native_grid(const veil_scene_volume* v, const float lo[3], const floa
     return 1;
 }
 
-/* The grid over [lo, hi]: native for VDBs without an explicit max_resolution, else fitted. */
+/* Why v cannot be sparse ("" when it can): volume/sparse.h. */
+static void sparse_obstacle(const veil_scene* s, const veil_scene_volume* v, char* why, size_t len)
+{
+    why[0] = 0;
+    if (s->medium.max_resolution_set)
+        snprintf(why, len, "medium.max_resolution asks for a resampled grid");
+    else if (v->particle_count > 0)
+        snprintf(why, len, "the medium has RBF particles (splatted into a dense grid)");
+    else if (v->vdb_count == 0)
+        snprintf(why, len, "the medium has no vdb source");
+    else if (v->emission_count > 0)
+        snprintf(why, len, "a vdb source has an emission or temperature grid (dense only)");
+    if (why[0]) return;
+    double edge0 = 0, origin0[3] = {0, 0, 0};
+    for (int i = 0; i < v->vdb_count; ++i) {
+        double e, o[3];
+        int al;
+        if (!veil_vdb_lattice(v->vdbs[i], &e, o, &al)) continue; /* no active voxel: adds nothing */
+        if (!al) {
+            snprintf(why, len, "%s: its voxels are rotated or not cubes", veil_vdb_path(v->vdbs[i]));
+            return;
+        }
+        if (edge0 == 0) {
+            edge0 = e;
+            memcpy(origin0, o, sizeof o);
+            continue;
+        }
+        int on = fabs(e - edge0) <= VEIL_VDB_ALIGN_TOL * edge0;
+        for (int a = 0; a < 3 && on; ++a) {
+            double k = (o[a] - origin0[a]) / edge0;
+            on = fabs(k - floor(k + 0.5)) <= VEIL_VDB_ALIGN_TOL;
+        }
+        if (!on) {
+            snprintf(why, len, "%s: its voxels are not on the lattice of %s", veil_vdb_path(v->vdbs[i]),
+                     veil_vdb_path(v->vdbs[0]));
+            return;
+        }
+    }
+}
+
+/* The grid over [lo, hi]: native for VDBs without an explicit max_resolution
+ * (sparse when the native grid is over the dense cap, or asked for), else fitted. */
 static veil_result choose_grid(const veil_scene* s, veil_scene_volume* v, const float lo[3], const float hi[3],
                                veil_error* err)
 {
     v->resolution[0] = 0;
-    if (!s->medium.max_resolution_set && v->vdb_count > 0 &&
-        native_grid(v, lo, hi, &v->grid, v->resolution, sizeof v->resolution))
+    veil_representation rep = s->medium.representation;
+    char obstacle[320];
+    sparse_obstacle(s, v, obstacle, sizeof obstacle);
+    if (rep == VEIL_REPRESENTATION_SPARSE && obstacle[0])
+        return veil_fail(err, VEIL_ERR_INVALID, "medium.representation: \"sparse\" is not possible here: %s", obstacle);
+    if (rep != VEIL_REPRESENTATION_SPARSE && !s->medium.max_resolution_set && v->vdb_count > 0 &&
+        native_grid(v, lo, hi, &v->grid, v->resolution, sizeof v->resolution, 0))
         return VEIL_OK;
+    if (rep != VEIL_REPRESENTATION_DENSE && !obstacle[0]) {
+        char dense_note[320];
+        snprintf(dense_note, sizeof dense_note, "%s", v->resolution);
+        if (native_grid(v, lo, hi, &v->grid, v->resolution, sizeof v->resolution, 1)) {
+            const int* d = v->grid.dims;
+            v->sparse = 1;
+            snprintf(v->resolution, sizeof v->resolution, "sparse: the VDB's %.4g m voxels, a %dx%dx%d box (%s)",
+                     v->grid.voxel, d[0], d[1], d[2],
+                     rep == VEIL_REPRESENTATION_SPARSE ? "medium.representation" : "over the dense cap of 2^27 voxels");
+            return VEIL_OK;
+        }
+        if (!v->resolution[0]) snprintf(v->resolution, sizeof v->resolution, "%s", dense_note);
+    }
     int res = s->medium.max_resolution;
     if (!s->medium.max_resolution_set && v->resolution[0]) {
         /* the native grid is too large: the finest that fits the cap, as a cube root of it */
         res = (int)cbrt((double)VEIL_NATIVE_MAX_VOXELS);
         if (res > VEIL_SCENE_MAX_RESOLUTION) res = VEIL_SCENE_MAX_RESOLUTION;
+        if (obstacle[0] && v->vdb_count > 0) {
+            size_t len = strlen(v->resolution);
+            snprintf(v->resolution + len, sizeof v->resolution - len, "; not sparse: %s", obstacle);
+        }
     }
     veil_result r = veil_grid_fit(lo, hi, res, &v->grid, err);
     if (r == VEIL_OK && !v->resolution[0])
@@ -365,6 +430,10 @@ veil_result veil_scene_volume_density(const veil_scene_volume* v, float** densit
 {
     *density = NULL;
     if (!v->has_volume) return veil_fail(err, VEIL_ERR_INVALID, "the scene has no voxelised source");
+    if (v->sparse)
+        return veil_fail(err, VEIL_ERR_LIMIT, "a %dx%dx%d grid (sparse) has no dense copy on the CPU: set "
+                         "medium.max_resolution (the dense cap is 2^27 voxels)", v->grid.dims[0], v->grid.dims[1],
+                         v->grid.dims[2]);
     size_t n = veil_grid_voxels(&v->grid);
     float* d = calloc(n, sizeof(float));
     if (!d) return veil_fail(err, VEIL_ERR_OOM, "out of memory for a %zu-voxel volume", n);

@@ -44,6 +44,7 @@ typedef struct veil_scene_volume {
     size_t vdb_voxels; /* active voxels over all grids */
     uint64_t key;      /* veil_scene_volume_key() of the scene */
     int has_volume;    /* 0: nothing to voxelise (then `grid` is unset) */
+    int sparse;        /* 1: the grid is held sparse (volume/sparse.h): its box may be far over the dense cap */
     veil_grid grid;
     /* How the grid was chosen, for --stats: "native: ..." or "resampled: ...",
      * and the files' grids that were not read ("; read 'density', not: vel (vec3s)") */

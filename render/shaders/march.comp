@@ -73,8 +73,21 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
     // an octave's reduced extinction a^i sigma_t never goes below that
     vec3 sigma_a = max(u.sigma_t.rgb - u.sigma_s.rgb, 0.0);
     vec3 floor_t = sqrt(3.0 * sigma_a * (sigma_a + u.sigma_s.rgb * (1.0 - u.march.w)));
-    float escape = u.diffusion.w == VEIL_FIELD_ESCAPE
-                 ? texture(u_phi, (x - u.diffusion.xyz) * u.diffusion_inv.xyz).r : 0.0;
+    bool use_escape = u.diffusion.w == VEIL_FIELD_ESCAPE;
+    float escape = 0.0;
+    if (use_escape) {
+#ifdef VEIL_SPARSE
+        // the field lives in the kept bricks; elsewhere (fog) the legs serve
+        vec3 q = (x - sp.origin.xyz) / sp.origin.w;
+        ivec3 b = sp_brick(q);
+        int region;
+        uint slot = sp_slot(b, region);
+        use_escape = slot != 0u;
+        if (use_escape) escape = texture(u_phi, sp_escape_uvw(slot, b, q)).r;
+#else
+        escape = texture(u_phi, (x - u.diffusion.xyz) * u.diffusion_inv.xyz).r;
+#endif
+    }
     for (int l = 0; l < u.size.z; ++l) {
         vec3 travel, E;
         float len;
@@ -87,11 +100,11 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
         // (D + p_cam kept finite: 0 * inf would be NaN where sigma_s = 0)
         // or, with the escape field, the chance averaged over all directions
         // (without a field, e.g. a fog box too large for a grid, the legs serve)
-        float gate = u.diffusion.w == VEIL_FIELD_ESCAPE ? escape
+        float gate = use_escape ? escape
                    : 1.0 - exp(-dot(u.sigma_s.rgb, vec3(1.0 / 3.0)) * min(D + p_cam, INF));
         // the legs' gate counts once; the escape field's chance is paid per further scattering
-        float a = 1.0, g = u.march.w, per = u.diffusion.w == VEIL_FIELD_ESCAPE ? gate : 1.0;
-        vec3 b = vec3(u.diffusion.w == VEIL_FIELD_ESCAPE ? 1.0 : gate);
+        float a = 1.0, g = u.march.w, per = use_escape ? gate : 1.0;
+        vec3 b = vec3(use_escape ? 1.0 : gate);
         for (int i = 1; i < octaves; ++i) {
             a *= u.octave.x, g *= u.octave.z;
             b *= u.octave.y * per * albedo;
@@ -147,6 +160,17 @@ void main()
         vec3 x0 = u.cam_pos.xyz + dir * t;
         bool in_ev = u.flags.x != 0u && t >= ev.x && t < ev.y;
         if (in_ev && u.flags.y != 0u) {
+#ifdef VEIL_SPARSE
+            // a brick not kept, or a whole empty node: jump to where the ray leaves it
+            vec3 q = (x0 - sp.origin.xyz) / sp.origin.w;
+            ivec3 b = sp_brick(q);
+            int region;
+            if (sp_slot(b, region) == 0u) {
+                float exit_t = t + sp_region_exit(q, dir, b, region) * sp.origin.w;
+                t = max(exit_t, t) + max(1e-4 * u.march.x, 2.4e-7 * abs(t));
+                continue;
+            }
+#else
             ivec3 b = ivec3(floor(((x0 - u.tex_min.xyz) / u.march.z - 0.5) / float(VEIL_BRICK)));
             b = clamp(b, ivec3(0), textureSize(u_occ, 0) - 1);
             if (texelFetch(u_occ, b, 0).r <= 0.0) {
@@ -156,6 +180,7 @@ void main()
                 t = max(exit_t, t) + max(1e-4 * u.march.x, 2.4e-7 * abs(t));
                 continue;
             }
+#endif
         }
         float step = in_ev ? u.march.x
                            : max(u.march.x, min(VEIL_FOG_STEP_FRACTION * max(t, u.march.x), 0.25 * nearest_light(x0)));
@@ -165,7 +190,7 @@ void main()
         if (!in_ev && u.flags.x != 0u && t < ev.x) te = min(te, ev.x); // do not step over the EV's entry
         float dt = te - t;
         vec3 x = u.cam_pos.xyz + dir * (0.5 * (t + te));
-        float rho_dt = in_ev ? texture(u_ev, (x - u.tex_min.xyz) * u.tex_inv_size.xyz).r * dt : 0.0;
+        float rho_dt = in_ev ? ev_density(x) * dt : 0.0;
         rho_dt = min(rho_dt + fog_integral(u.cam_pos.xyz, dir, t, te), INF); // finite, as D in in_scattered
 #ifdef VEIL_MARCH_EMISSION /* a variant: llvmpipe runs a masked-off texture read anyway (10 % of the march) */
         if (in_ev && u.limits.y != 0.0) {

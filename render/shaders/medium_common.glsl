@@ -1,29 +1,27 @@
 // veil — the medium and the lights as the march and the diffusion source
 // pass see them (included with //@include): the march's uniform block, the
 // EV and the optical-depth volumes, fogs in closed form.
-layout(binding = VEIL_TEX_EV) uniform sampler3D u_ev;
+// With VEIL_SPARSE the EV is an atlas of bricks (volume/sparse.h), read
+// through volume/shaders/sparse_common.glsl, and so are the optical depths.
 layout(binding = VEIL_TEX_OPV0) uniform sampler3D u_opv[VEIL_MAX_OPV_TEXTURES];
 layout(std140, binding = VEIL_UBO_MARCH) uniform veil_march_ubo { veil_march_block u; };
+//@include volume/shaders/box_hit.glsl
+#ifdef VEIL_SPARSE
+//@include volume/shaders/sparse_common.glsl
+#else
+layout(binding = VEIL_TEX_EV) uniform sampler3D u_ev;
+#endif
 
-const float INF = 3.0e38;
-
-
-// Slab test of o + t dir, t in [tmin, tmax]; empty when .x >= .y.
-vec2 box_hit(vec3 o, vec3 dir, vec3 lo, vec3 hi, float tmin, float tmax)
+// The EV's density at x (inside its box).
+float ev_density(vec3 x)
 {
-    vec3 inv = 1.0 / dir; // +-inf on zero components: the slab test still holds...
-    vec3 a = (lo - o) * inv, b = (hi - o) * inv;
-    vec3 t0 = min(a, b), t1 = max(a, b);
-    // ...except for o on a slab's plane (0 * inf = NaN): along a zero component
-    // the ray is in that slab for every t, or for none
-    bvec3 zero_dir = equal(dir, vec3(0.0));
-    bvec3 in_slab = bvec3(greaterThanEqual(o, lo).x && lessThanEqual(o, hi).x,
-                          greaterThanEqual(o, lo).y && lessThanEqual(o, hi).y,
-                          greaterThanEqual(o, lo).z && lessThanEqual(o, hi).z);
-    t0 = mix(t0, mix(vec3(INF), vec3(-INF), in_slab), zero_dir);
-    t1 = mix(t1, mix(vec3(-INF), vec3(INF), in_slab), zero_dir);
-    return vec2(max(max(t0.x, t0.y), max(t0.z, tmin)), min(min(t1.x, t1.y), min(t1.z, tmax)));
+#ifdef VEIL_SPARSE
+    return sp_density((x - sp.origin.xyz) / sp.origin.w);
+#else
+    return texture(u_ev, (x - u.tex_min.xyz) * u.tex_inv_size.xyz).r;
+#endif
 }
+
 
 // Density integral of all fogs along p + t d, t in [t0, t1] (d unit).
 float fog_integral(vec3 p, vec3 d, float t0, float t1)
@@ -46,10 +44,21 @@ float fog_integral(vec3 p, vec3 d, float t0, float t1)
 float ev_depth(int l, vec3 x, vec3 to, float len)
 {
     if (u.flags.x == 0u) return 0.0;
+#ifdef VEIL_SPARSE
+    // in a kept brick, the optical-depth atlas; elsewhere (fog around the
+    // volume) the path to the light, marched through the bricks it meets
+    vec3 q = (x - sp.origin.xyz) / sp.origin.w;
+    ivec3 b = sp_brick(q);
+    int region;
+    uint slot = sp_slot(b, region);
+    if (slot != 0u) return texture(u_opv[l / 4], sp_atlas_uvw(slot, b, q))[l % 4];
+    return sp_integral(q, to, 0.0, min(len / sp.origin.w, INF)) * sp.origin.w;
+#else
     vec2 s = box_hit(x, to, u.box_min.xyz, u.box_max.xyz, 0.0, len);
     if (s.x > s.y) return 0.0;
     vec3 y = x + to * s.x;
     return texture(u_opv[l / 4], (y - u.tex_min.xyz) * u.tex_inv_size.xyz)[l % 4];
+#endif
 }
 
 // Light l at x before the medium: the direction it travels, its irradiance
