@@ -20,6 +20,9 @@
 //   rotated.vdb          "density": a Gaussian blob under scale + rotation + translation
 //   frustum.vdb          "density": a frustum (non-affine) transform
 //   far_apart.vdb        "density": two voxels at index (0,0,0) and (1100,1100,1100)
+//   sparse_puffs.vdb     "density", voxel 0.05 m: Gaussian puffs over a 4096^3 index box
+//                        (under 1e-5 of it active): the crop's three and 24 more (below)
+//   sparse_crop.vdb      "density": the crop's three puffs alone (fits a dense grid)
 //   two_grids.vdb        "temperature" then "density" (written without stats metadata)
 //   smoke_plume.vdb      "density": a procedural noisy plume, ~10^5 active voxels, hard edges
 //   truncated.vdb        the first half of fog_sphere.vdb's bytes
@@ -156,6 +159,48 @@ void copy_prefix(const char* from, const char* to, double fraction)
     if (!out) throw std::runtime_error(std::string("cannot write ") + path(to));
 }
 
+// Adds a Gaussian puff (peak a, sigma s voxels, cut at 3 s) centred on index c.
+void puff(FloatGrid& g, Coord c, float a, double s)
+{
+    FloatGrid::Accessor acc = g.getAccessor();
+    int r = (int)std::ceil(3.0 * s);
+    for (int k = -r; k <= r; ++k)
+        for (int j = -r; j <= r; ++j)
+            for (int i = -r; i <= r; ++i) {
+                double r2 = (double)i * i + (double)j * j + (double)k * k;
+                if (r2 > 9.0 * s * s) continue;
+                Coord p = c + Coord(i, j, k);
+                acc.setValue(p, acc.getValue(p) + a * (float)std::exp(-0.5 * r2 / (s * s)));
+            }
+}
+
+// The sparse pair (tests/vdb_sparse.sh). The crop: three puffs (sigma 3
+// voxels) around index (2000, 2000, 9), their lowest voxel at k = 0. The
+// rest: puffs reaching the far corners (4095, 4095, 4095) and (0, 0, 4095), and 23 more at
+// pseudo-random places with j <= 1500 and k >= 40: from a camera on -z
+// looking at the crop with a narrow view they are out of sight, and under
+// a sun straight down (-y) they shade nothing of the crop. Both files' boxes
+// then begin on the same k plane, the crop's.
+void sparse_pair()
+{
+    const Coord crop[3] = {Coord(2000, 2000, 9), Coord(2010, 2004, 11), Coord(1993, 2008, 12)};
+    FloatGrid::Ptr all = float_grid("density", 0.05), part = float_grid("density", 0.05);
+    for (const Coord& c : crop) puff(*all, c, 1.0f, 3.0), puff(*part, c, 1.0f, 3.0);
+    puff(*all, Coord(4095 - 9, 4095 - 9, 4095 - 9), 1.0f, 3.0);
+    puff(*all, Coord(9, 9, 4095 - 9), 1.0f, 3.0);
+    uint64_t x = 12345;
+    for (int n = 0; n < 23; ++n) {
+        int v[3];
+        for (int a = 0; a < 3; ++a) {
+            x = x * 6364136223846793005ull + 1442695040888963407ull;
+            v[a] = 20 + (int)((x >> 33) % 4056);
+        }
+        puff(*all, Coord(v[0], 20 + v[1] % 1480, 40 + v[2] % 4000), 0.8f, 3.0);
+    }
+    write("sparse_puffs.vdb", {all});
+    write("sparse_crop.vdb", {part});
+}
+
 void make_all(bool big)
 {
     const float sphere_voxel = 0.05f, sphere_radius = 1.0f; // 20 voxels
@@ -246,6 +291,8 @@ void make_all(bool big)
     for (int i = 0; i < 3; ++i) temp->tree().setValue(Coord(i, 0, 0), 300.0f);
     for (int i = 0; i < 5; ++i) dens->tree().setValue(Coord(0, i, 0), 0.5f);
     write("two_grids.vdb", {temp, dens}, false);
+
+    sparse_pair();
 
     write("smoke_plume.vdb", {plume(1.0)});
     if (big) write("big_plume.vdb", {plume(2.2)});

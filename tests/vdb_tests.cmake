@@ -48,6 +48,16 @@ foreach(case native nanovdb filters)
   set_tests_properties(vdb_${case} PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "unit;accuracy")
 endforeach()
 
+# The sparse volume (tests/test_sparse.c): the 4096^3 puffs file against its crop.
+add_executable(test_sparse ${CMAKE_CURRENT_SOURCE_DIR}/test_sparse.c ${CMAKE_CURRENT_SOURCE_DIR}/check.c)
+target_link_libraries(test_sparse PRIVATE veil veil_fp veil_warnings)
+add_test(NAME sparse_structure COMMAND test_sparse ${VDB_DATA} structure)
+set_tests_properties(sparse_structure PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "unit;accuracy")
+foreach(case depth render)
+  add_test(NAME sparse_${case} COMMAND test_sparse ${VDB_DATA} ${case})
+  set_tests_properties(sparse_${case} PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "gpu;accuracy" SKIP_RETURN_CODE 77)
+endforeach()
+
 # `veil info` (tests/vdb_bad.sh VEIL EXPECTED_EXIT EXPECTED_TEXT ARGS...).
 function(veil_vdb_cli name rc text)
   add_test(NAME vdb_cli_${name}
@@ -72,6 +82,26 @@ veil_vdb_cli(info_garbage 1 "garbage.vdb: cannot read the OpenVDB file" info ${V
 veil_vdb_cli(info_missing 1 "does_not_exist.vdb: cannot open: No such file or directory"
              info ${VDB_DATA}/does_not_exist.vdb)
 veil_vdb_cli(info_usage 2 "info: missing FILE.vdb" info)
+
+# A sparse volume asked for where there cannot be one (a rotated grid): exit 1
+# naming the field and why, nothing written (tests/bad_input.sh).
+file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/bad_sparse_rotated.json
+  "{\"camera\": {\"position\": [0, 0, 3], \"look_at\": [0, 0, 0], \"width\": 8, \"height\": 6},
+    \"medium\": {\"sigma_s\": [1, 1, 1], \"representation\": \"sparse\",
+      \"sources\": [{\"type\": \"vdb\", \"file\": \"${VDB_DATA}/rotated.vdb\"}]}}\n")
+add_test(NAME bad_input_sparse_rotated
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/bad_input.sh $<TARGET_FILE:veil_cli>
+                 ${CMAKE_CURRENT_BINARY_DIR}/bad_sparse_rotated.json
+                 "medium.representation: \"sparse\" is not possible here: ${VDB_DATA}/rotated.vdb: its voxels are rotated or not cubes")
+set_tests_properties(bad_input_sparse_rotated PROPERTIES FIXTURES_REQUIRED vdb_data LABELS bad_input)
+# The 4096^3 puffs render sparse by themselves and say so, with the memory.
+file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/sparse_puffs_scene.json
+  "{\"camera\": {\"position\": [100, 100, -8], \"look_at\": [100, 100, 0], \"width\": 16, \"height\": 12},
+    \"medium\": {\"sigma_s\": [5, 5, 5], \"sources\": [{\"type\": \"vdb\", \"file\": \"${VDB_DATA}/sparse_puffs.vdb\"}]},
+    \"lights\": [{\"type\": \"directional\", \"direction\": [0, -1, 0], \"irradiance\": [1, 1, 1]}]}\n")
+veil_vdb_cli(render_sparse 0 "bricks kept of 135005697 (513x513x513)" render
+             ${CMAKE_CURRENT_BINARY_DIR}/sparse_puffs_scene.json -o ${CMAKE_CURRENT_BINARY_DIR}/sparse_puffs.exr --stats)
+set_tests_properties(vdb_cli_render_sparse PROPERTIES LABELS "cli;gpu")
 
 # Emission (a vdb source's "emission" grid): march and reference against the
 # closed form of an emissive absorbing slab.
