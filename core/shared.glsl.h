@@ -118,7 +118,8 @@
  * Filled from scene/scene.h's veil_light by veil_gpu_light_from(). */
 VEIL_STRUCT_BEGIN(veil_gpu_light)
     VEIL_V4(position);  /* xyz: point, spot position (m); w: type, VEIL_LIGHT_* */
-    VEIL_V4(direction); /* xyz: directional: unit travel direction; spot: its axis; w: spot cos(inner angle) */
+    VEIL_V4(direction); /* xyz: directional: unit travel direction; spot: its axis; w: spot cos(inner angle),
+                           point: floor on r^2 (m^2, its radius squared) */
     VEIL_V4(color);     /* rgb: W/sr (point, spot) or W/m^2 (directional); w: spot cos(outer angle) */
 VEIL_STRUCT_END(veil_gpu_light)
 

@@ -224,9 +224,11 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
     }
     rep->status = orep.computed ? VEIL_STAGE_RAN : VEIL_STAGE_CACHED;
     const char* method = sp ? "marched per kept voxel (sparse)" : veil_opv_method_name(o->method);
+    char from[64] = "";
+    if (st->emission_lights) snprintf(from, sizeof from, " (+%d from the emission)", st->emission_lights);
     if (orep.computed)
-        why(rep, "%d of %zu lights, %s, %d passes; %d textures computed (volume or light moved), %d cached", n,
-            s->light_count, method, orep.iterations, orep.computed, orep.cached);
+        why(rep, "%d of %zu lights%s, %s, %d passes; %d textures computed (volume or light moved), %d cached",
+            n - st->emission_lights, s->light_count, from, method, orep.iterations, orep.computed, orep.cached);
     else
         why(rep, "%d lights, %s: the volume, method and lights' geometry are unchanged", n, method);
     return res;
@@ -358,6 +360,12 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
     const veil_grid* g = veil_ev_grid(r->ev);
     veil_light lights[VEIL_MAX_LIGHTS];
     int n = veil_render_lights(s, g, lights);
+    /* the medium's emission as lights (volume/emission_lights.h): after the scene's, while there is room */
+    int emitting = 0;
+    const veil_light* el = veil_ev_emission_lights(r->ev, &emitting);
+    if (emitting > VEIL_MAX_LIGHTS - n) emitting = VEIL_MAX_LIGHTS - n;
+    for (int i = 0; i < emitting; ++i) lights[n++] = el[i];
+    st->emission_lights = emitting;
     st->fogs = count_fogs(s);
     st->lights_used = n;
     st->method = o->method;

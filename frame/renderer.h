@@ -76,7 +76,8 @@ typedef struct veil_render_stats {
     veil_grid grid;       /* the EV's geometry when has_volume */
     size_t particles;
     size_t vdb_voxels;    /* active voxels of the OpenVDB grids (0 when cached) */
-    int lights_used;      /* lights that reach the medium and add light */
+    int lights_used;      /* lights that reach the medium and add light (with the emission's) */
+    int emission_lights;  /* of them, the medium's emission as lights (volume/emission_lights.h) */
     int fogs;             /* analytic fogs (closed form, never voxelised) */
     int opv_computed, opv_cached; /* OPV textures made / reused */
     veil_opv_method method;

@@ -9,7 +9,7 @@
 static const char* const MS_KEYS[] = {
     "screen_space", "volumetric", "c", "mask_epsilon", "mask", "luminance_weighting", "density_blur", "levels",
     "filter", "weights", "interpolation", "separation", "separation_luminance", "separation_luminance_width",
-    "separation_density", "separation_density_width", "k_ssc", "thin_threshold", "octaves", "octave_extinction",
+    "separation_density", "separation_density_width", "k_ssc", "thin_threshold", "octaves", "emission_lights", "octave_extinction",
     "octave_contribution", "octave_eccentricity", "volumetric_method", "diffusion_cells", "diffusion_iterations",
     "octave_gate", NULL};
 static const char* const GATES[] = {"legs", "escape", NULL}; /* = veil_octave_gate */
@@ -24,6 +24,7 @@ static const range R_UNIT_CLOSED = {0, 1, false, false, false, "a number in [0, 
 static const range R_UNIT_OPEN_LO = {0, 1, true, false, false, "a number in (0, 1]"};
 static const range R_UNIT_OPEN_HI = {0, 1, false, true, false, "a number in [0, 1)"};
 static const range R_OCTAVES = {1, 16, false, false, true, "an integer in [1, 16]"};
+static const range R_EMISSION_LIGHTS = {0, 16, false, false, true, "an integer in [0, 16]"};
 static const range R_CELLS = {8, 256, false, false, true, "an integer in [8, 256]"};
 static const range R_ITER = {0, 100000, false, false, true, "an integer in [0, 100000] (0: 3 x the cells)"};
 
@@ -106,6 +107,7 @@ veil_result veil__parse_multiple(const ctx* c, const cJSON* root, veil_multiple*
     TRY(get_float(c, o, &p, "k_ssc", &R_UNIT_CLOSED, &m->k_ssc));
     TRY(get_float(c, o, &p, "thin_threshold", &R_NONNEG, &m->thin_threshold));
     TRY(veil__jr_get_int(c, o, &p, "octaves", &R_OCTAVES, &m->octaves));
+    TRY(veil__jr_get_int(c, o, &p, "emission_lights", &R_EMISSION_LIGHTS, &m->emission_lights));
     TRY(veil__jr_get_name(c, o, &p, "octave_gate", GATES, &m->octave_gate));
     TRY(get_float(c, o, &p, "octave_extinction", &R_UNIT_OPEN_LO, &m->octave_a));
     TRY(get_float(c, o, &p, "octave_contribution", &R_UNIT_OPEN_HI, &m->octave_b));

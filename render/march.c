@@ -50,7 +50,8 @@ static void set3(float dst[4], const float src[3], float w)
 void veil_gpu_light_from(const veil_light* l, veil_gpu_light* out)
 {
     set3(out->position, l->position, (float)l->type);
-    set3(out->direction, l->direction, cosf(l->inner_angle_deg * (float)(VEIL_PI / 180.0)));
+    set3(out->direction, l->direction,
+         l->type == VEIL_LIGHT_POINT ? l->radius * l->radius : cosf(l->inner_angle_deg * (float)(VEIL_PI / 180.0)));
     set3(out->color, l->color, cosf(l->outer_angle_deg * (float)(VEIL_PI / 180.0)));
 }
 

@@ -112,6 +112,7 @@ void veil_multiple_defaults(veil_multiple* m)
      * (bench/multiple_scattering_fit.py;
      * docs/multiple-scattering.md has the grid, the fit and the check on scenes it never saw) */
     m->octaves = 10;
+    m->emission_lights = 8;
     m->octave_a = 0.3f;
     m->octave_b = 0.9f;
     m->octave_c = 0.7f;

@@ -135,6 +135,9 @@ typedef struct veil_light {
     /* spot: full intensity within inner_angle_deg of the axis, none beyond
      * outer_angle_deg, veil_spot_falloff() between; 0 <= inner < outer <= 180 */
     float inner_angle_deg, outer_angle_deg;
+    /* point: 1/r^2 is floored at radius^2 (m; 0 for a scene's lights: a point;
+     * the medium's emission as lights, volume/emission_lights.h, has a size) */
+    float radius;
 } veil_light;
 
 /* Multiple scattering ("multiple_scattering" in a scene file; see
@@ -190,6 +193,9 @@ typedef struct veil_multiple {
     float octave_b;       /* contribution scale per octave, [0, 1) */
     float octave_c;       /* phase g scale per octave, [0, 1] */
     int octave_gate;      /* VEIL_GATE_*: what scales the octaves where little medium surrounds a point */
+    /* the medium's emission as up to this many point lights (volume/emission_lights.h), 0..16: what the
+     * fire emits lights its smoke through every estimate; the scene's own lights come first */
+    int emission_lights;
 } veil_multiple;
 
 /* The defaults: every field as documented in docs/scene-format.md. */

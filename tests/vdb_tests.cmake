@@ -110,6 +110,16 @@ target_link_libraries(test_emission PRIVATE veil veil_fp veil_warnings)
 add_test(NAME test_emission COMMAND test_emission ${VDB_DATA})
 set_tests_properties(test_emission PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "gpu;accuracy" SKIP_RETURN_CODE 77)
 
+# The emission lights its medium: 8 lights from the slab's emission (its 4000 voxels split k-d) join the scene's.
+file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/emission_lights_scene.json
+  "{\"camera\": {\"position\": [0.95, 0.95, 6], \"look_at\": [0.95, 0.95, 0], \"width\": 16, \"height\": 12},
+    \"medium\": {\"sigma_a\": [1, 1, 1], \"sigma_s\": [3, 3, 3], \"sources\": [{\"type\": \"vdb\",
+      \"file\": \"${VDB_DATA}/emissive_slab.vdb\", \"emission\": {\"grid\": \"heat\"}}]},
+    \"lights\": [{\"type\": \"directional\", \"direction\": [0, 0, -1], \"irradiance\": [1, 1, 1]}]}\n")
+veil_vdb_cli(render_emission_lights 0 "1 of 1 lights (+8 from the emission)" render
+             ${CMAKE_CURRENT_BINARY_DIR}/emission_lights_scene.json -o ${CMAKE_CURRENT_BINARY_DIR}/emission_lights.exr --stats)
+set_tests_properties(vdb_cli_render_emission_lights PROPERTIES LABELS "cli;gpu")
+
 # A vdb source's emission or temperature grid that the file lacks: exit 1 naming
 # the field and the file's grids, nothing written (tests/bad_input.sh).
 foreach(field emission temperature)

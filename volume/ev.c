@@ -5,6 +5,7 @@
 
 #include "../gpu/gl_util.h"
 #include "../gpu/programs.h"
+#include "emission_lights.h"
 #include "inject_gpu.h"
 
 struct veil_ev {
@@ -13,6 +14,8 @@ struct veil_ev {
     GLuint emission;          /* rgba32f emission (0: none) */
     int present, is_sparse;
     veil_ev_sparse sparse;
+    veil_light lights[VEIL_MAX_LIGHTS]; /* the emission as lights */
+    int light_count;
     veil_grid grid;
 };
 
@@ -38,6 +41,7 @@ void veil_ev_clear(veil_ev* ev)
     glDeleteTextures(1, &ev->emission);
     ev->tex = ev->occ = ev->emission = 0;
     ev->present = 0;
+    ev->light_count = 0;
     if (ev->is_sparse) {
         veil_ev_sparse* sp = &ev->sparse;
         glDeleteTextures(1, &sp->top);
@@ -48,6 +52,12 @@ void veil_ev_clear(veil_ev* ev)
         memset(sp, 0, sizeof *sp);
         ev->is_sparse = 0;
     }
+}
+
+const veil_light* veil_ev_emission_lights(const veil_ev* ev, int* n)
+{
+    *n = ev->present ? ev->light_count : 0;
+    return ev->lights;
 }
 
 const veil_ev_sparse* veil_ev_sparse_of(const veil_ev* ev) { return ev->present && ev->is_sparse ? &ev->sparse : NULL; }
@@ -243,6 +253,7 @@ veil_result veil_ev_build_scene(veil_ev* ev, const veil_scene_volume* v, int n_l
                                 emission);
             r = veil_gl_check("uploading the emission", err);
         }
+        if (r == VEIL_OK) r = veil_emission_lights(g, emission, v->emission_lights, ev->lights, &ev->light_count, err);
     }
     free(emission);
     if (r != VEIL_OK) veil_ev_clear(ev);

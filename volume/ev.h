@@ -31,6 +31,11 @@ typedef struct veil_ev_report {
     size_t bytes;      /* GPU bytes of the volume (texture and occupancy, or atlas and tables) */
 } veil_ev_report;
 
+/* The emission of the scene's grids as point lights (volume/emission_lights.h,
+ * at most v->emission_lights of them), made with the emission texture; *n = 0
+ * when there is none. */
+const veil_light* veil_ev_emission_lights(const veil_ev* ev, int* n);
+
 /* A sparse EV's GPU objects. */
 typedef struct veil_ev_sparse {
     GLuint atlas;              /* r32f 3D: the kept bricks' texels (also veil_ev_texture) */

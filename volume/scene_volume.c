@@ -213,6 +213,7 @@ uint64_t veil_scene_volume_key(const veil_scene* s)
             k = veil_hash_bytes(k, &src->vdb.temperature_offset, sizeof src->vdb.temperature_offset);
             k = veil_hash_bytes(k, &src->vdb.temperature_intensity, sizeof src->vdb.temperature_intensity);
             k = veil_hash_bytes(k, s->medium.sigma_a, sizeof s->medium.sigma_a); /* Kirchhoff's k */
+            k = veil_hash_bytes(k, &s->multiple.emission_lights, sizeof s->multiple.emission_lights);
         }
     }
     return k;
@@ -399,6 +400,7 @@ veil_result veil_scene_volume_open(const veil_scene* s, veil_scene_volume* out, 
     memset(out, 0, sizeof *out);
     v.key = veil_scene_volume_key(s);
     memcpy(v.sigma_a, s->medium.sigma_a, sizeof v.sigma_a);
+    v.emission_lights = s->multiple.emission_lights;
     veil_result r = veil_scene_particles(s, &v.particles, &v.particle_count, err);
     float lo[3], hi[3], a[3], b[3];
     int any = 0;

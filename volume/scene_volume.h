@@ -54,6 +54,7 @@ typedef struct veil_scene_volume {
     veil_emission_source emission[2 * VEIL_MAX_VDB_SOURCES];
     int emission_count;
     float sigma_a[3]; /* the medium's, for temperature grids' Kirchhoff emission */
+    int emission_lights; /* multiple_scattering.emission_lights: the emission as at most this many lights */
 } veil_scene_volume;
 
 /* The emission on v->grid: a newly calloc'd *rgba (4 floats a voxel: the

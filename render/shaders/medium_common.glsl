@@ -52,7 +52,7 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
     int region;
     uint slot = sp_slot(b, region);
     if (slot != 0u) return texture(u_opv[l / 4], sp_atlas_uvw(slot, b, q))[l % 4];
-    return sp_integral(q, to, 0.0, min(len / sp.origin.w, INF)) * sp.origin.w;
+    return sp_integral(q, to, 0.0, min(len / sp.origin.w, INF), VEIL_SPARSE_OD_STEP) * sp.origin.w;
 #else
     vec2 s = box_hit(x, to, u.box_min.xyz, u.box_max.xyz, 0.0, len);
     if (s.x > s.y) return 0.0;
@@ -68,7 +68,8 @@ bool light_at(int l, vec3 x, out vec3 travel, out vec3 E, out float len)
 {
     if (int(u.lights[l].position.w) != VEIL_LIGHT_DIRECTIONAL) {
         vec3 to_light = u.lights[l].position.xyz - x;
-        float r2 = max(dot(to_light, to_light), u.march.y);
+        float r2 = max(dot(to_light, to_light),
+                       int(u.lights[l].position.w) == VEIL_LIGHT_POINT ? max(u.march.y, u.lights[l].direction.w) : u.march.y);
         len = sqrt(r2);
         travel = -to_light / len;
         E = u.lights[l].color.rgb / r2;
