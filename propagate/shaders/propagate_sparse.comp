@@ -33,7 +33,7 @@ void main()
             len = length(to);
             d = len > 0.0 ? to / len : vec3(0.0, 0.0, 1.0);
         }
-        D[l] = sp_integral(q, d, 0.0, len) * sp.origin.w;
+        D[l] = sp_integral(q, d, 0.0, len, VEIL_SPARSE_OD_STEP) * sp.origin.w;
     }
     imageStore(u_out, texel, D);
 }

@@ -22,8 +22,8 @@ float ev_integral(vec3 x, vec3 d)
 {
     if (u.flags.x == 0u) return 0.0;
 #ifdef VEIL_SPARSE
-    return sp_integral((x - sp.origin.xyz) / sp.origin.w, d, 0.0, INF) * sp.origin.w;
-#endif
+    return sp_integral((x - sp.origin.xyz) / sp.origin.w, d, 0.0, INF, 1.0) * sp.origin.w; // a step a voxel, as below
+#else
     vec2 s = box_hit(x, d, u.box_min.xyz, u.box_max.xyz, 0.0, INF);
     if (s.x >= s.y) return 0.0;
     float step = u.march.z, sum = 0.0;
@@ -34,6 +34,7 @@ float ev_integral(vec3 x, vec3 d)
         sum += texture(u_ev, (p - u.tex_min.xyz) * u.tex_inv_size.xyz).r * dt;
     }
     return sum;
+#endif
 }
 
 void main()

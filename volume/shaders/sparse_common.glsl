@@ -81,9 +81,8 @@ float sp_region_exit(vec3 p, vec3 d, ivec3 b, int region)
 
 // The density integral (density x voxels) along q + t d (d unit) for t in
 // [t0, t1], within the box of voxel centres: brick by brick, midpoint steps
-// of at most VEIL_SPARSE_OD_STEP voxels, bricks and nodes not kept skipped
-// (their density is 0).
-float sp_integral(vec3 q, vec3 d, float t0, float t1)
+// of at most h voxels, bricks and nodes not kept skipped (their density is 0).
+float sp_integral(vec3 q, vec3 d, float t0, float t1, float h)
 {
     vec2 s = box_hit(q, d, vec3(0.5), sp.dims.xyz - 0.5, t0, t1);
     float sum = 0.0, t = s.x;
@@ -96,7 +95,7 @@ float sp_integral(vec3 q, vec3 d, float t0, float t1)
         uint slot = sp_slot(b, region);
         float te = min(t + max(sp_region_exit(p, d, b, slot == 0u ? region : 1), ahead), s.y);
         if (slot != 0u) {
-            int n = int(ceil((te - t) / VEIL_SPARSE_OD_STEP));
+            int n = int(ceil((te - t) / h));
             float dt = (te - t) / float(max(n, 1));
             vec3 base = sp_corner(slot) * float(VEIL_SPARSE_APRON) + 0.5;
             for (int i = 0; i < n; ++i) {
