@@ -177,6 +177,7 @@ VEIL_STRUCT_END(veil_march_block)
 #define VEIL_TEX_SPARSE_NODES 10  /* texture unit: r32ui buffer, the nodes' tables (0: empty brick, else slot + 1) */
 #define VEIL_TEX_SPARSE_COORDS 11 /* texture unit: rgba32i buffer, each slot's brick */
 #define VEIL_TEX_SPARSE_ESCAPE 12 /* texture unit: r32f 3D, the escape field per brick */
+#define VEIL_TEX_SPARSE_LIST 13   /* texture unit: r32i buffer, slots in the order a pass takes them */
 #define VEIL_IMAGE_SPARSE_OUT 0   /* image unit: what a sparse pass writes (atlas-shaped) */
 
 VEIL_STRUCT_BEGIN(veil_sparse_block)

@@ -223,7 +223,7 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
         rep->key = veil_hash_bytes(rep->key, &ol, sizeof ol);
     }
     rep->status = orep.computed ? VEIL_STAGE_RAN : VEIL_STAGE_CACHED;
-    const char* method = sp ? "marched per kept voxel (sparse)" : veil_opv_method_name(o->method);
+    const char* method = sp ? "sparse: brick by brick in the light's order" : veil_opv_method_name(o->method);
     char from[64] = "";
     if (st->emission_lights) snprintf(from, sizeof from, " (+%d from the emission)", st->emission_lights);
     if (orep.computed)

@@ -1,5 +1,6 @@
 #include "opv_set.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -70,37 +71,121 @@ static veil_result texture_of(veil_opv_set* s, int t, const int dims[3], const c
     return r;
 }
 
-/* Texture t over a sparse volume: propagate/shaders/propagate_sparse.comp. */
-static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, const veil_grid* g,
-                                 const veil_opv_light* ol, int count, GLuint tex, veil_error* err)
+/* The order of light l's passes over a sparse volume: each slot's level,
+ * so that a brick's path to the light leaves it towards bricks of lower
+ * levels only. A sun: sum over axes of s_a b_a, s_a the sign of the
+ * direction towards it (crossing a face towards the light adds 1), the
+ * highest first: returned negated. A point light in brick c: the Manhattan
+ * distance sum |b_a - c_a| (crossing a face towards it takes 1 off; where
+ * b_a = c_a the path stays in that slab), from 0 up. So the lowest value
+ * goes first either way. */
+static long long level_of(const veil_opv_light* l, const int32_t* b, int sun_sign[3], const int c[3])
+{
+    long long v = 0;
+    for (int a = 0; a < 3; ++a)
+        v += l->type == VEIL_LIGHT_DIRECTIONAL ? -(long long)sun_sign[a] * b[a] : llabs((long long)b[a] - c[a]);
+    return v;
+}
+
+/* Texture t over a sparse volume: for each light, passes of
+ * propagate/shaders/propagate_sparse.comp over the kept bricks, level by
+ * level (each pass reads only bricks of earlier passes). *passes: the most
+ * passes of any light. */
+static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, const veil_opv_light* ol, int count,
+                                 GLuint tex, int* passes, veil_error* err)
 {
     veil_result r = VEIL_OK;
     if (!s->sparse_program) r = veil_gpu_program("propagate/shaders/propagate_sparse.comp", &s->sparse_program, err);
     if (r != VEIL_OK) return r;
+    size_t n = sp->slots;
+    long long* level = malloc((n ? n : 1) * sizeof *level);
+    int32_t* list = malloc((n ? n : 1) * sizeof *list);
+    size_t* first = NULL;
+    GLuint buf = 0, list_tex = 0;
+    if (!level || !list) r = veil_fail(err, VEIL_ERR_OOM, "out of memory ordering %zu bricks", n);
     GLuint p = s->sparse_program;
-    float lights[16] = {0};
-    for (int c = 0; c < count; ++c) {
-        /* opv.h's index space has voxel i's centre at i; the sparse one at i + 0.5 */
-        float shift = ol[c].type == VEIL_LIGHT_DIRECTIONAL ? 0.0f : 0.5f;
-        for (int a = 0; a < 3; ++a) lights[4 * c + a] = ol[c].v[a] + shift;
-        lights[4 * c + 3] = (float)ol[c].type;
+    static const float zero[4] = {0, 0, 0, 0};
+    glClearTexImage(tex, 0, GL_RGBA, GL_FLOAT, zero);
+    *passes = 0;
+    for (int c = 0; c < count && r == VEIL_OK && n > 0; ++c) {
+        /* the light in the sparse index space (opv.h's has voxel i's centre at i, this one at i + 0.5) */
+        float light[4];
+        int sign[3], cb[3];
+        for (int a = 0; a < 3; ++a) {
+            light[a] = ol[c].v[a] + (ol[c].type == VEIL_LIGHT_DIRECTIONAL ? 0.0f : 0.5f);
+            sign[a] = ol[c].v[a] > 0.0f ? 1 : ol[c].v[a] < 0.0f ? -1 : 0;
+            double cell = floor(((double)light[a] - 0.5) / VEIL_BRICK);
+            cb[a] = cell < -1e9 ? -1000000000 : cell > 1e9 ? 1000000000 : (int)cell;
+        }
+        light[3] = (float)ol[c].type;
+        /* counting sort of the slots by level */
+        long long lo = 0, hi = 0;
+        for (size_t i = 0; i < n; ++i) {
+            level[i] = level_of(&ol[c], sp->bricks + 4 * i, sign, cb);
+            if (i == 0 || level[i] < lo) lo = level[i];
+            if (i == 0 || level[i] > hi) hi = level[i];
+        }
+        size_t levels = (size_t)(hi - lo) + 1;
+        free(first);
+        first = calloc(levels + 1, sizeof *first);
+        if (!first) {
+            r = veil_fail(err, VEIL_ERR_OOM, "out of memory for %zu passes", levels);
+            break;
+        }
+        for (size_t i = 0; i < n; ++i) ++first[level[i] - lo + 1];
+        for (size_t k = 0; k < levels; ++k) first[k + 1] += first[k];
+        size_t* at = calloc(levels, sizeof *at);
+        if (!at) {
+            r = veil_fail(err, VEIL_ERR_OOM, "out of memory for %zu passes", levels);
+            break;
+        }
+        for (size_t i = 0; i < n; ++i) {
+            size_t k = (size_t)(level[i] - lo);
+            list[first[k] + at[k]++] = (int32_t)i;
+        }
+        free(at);
+        glDeleteTextures(1, &list_tex);
+        glDeleteBuffers(1, &buf);
+        list_tex = buf = 0;
+        r = veil_gl_buffer(list, n * sizeof *list, 0, "veil sparse pass order", &buf, err);
+        if (r != VEIL_OK) break;
+        glCreateTextures(GL_TEXTURE_BUFFER, 1, &list_tex);
+        glTextureBuffer(list_tex, GL_R32I, buf);
+        glUseProgram(p);
+        glProgramUniform4fv(p, glGetUniformLocation(p, "u_light"), 1, light);
+        glProgramUniform1i(p, glGetUniformLocation(p, "u_channel"), c);
+        veil_ev_sparse_bind(sp);
+        glBindTextureUnit(VEIL_TEX_EV, sp->atlas);
+        glBindTextureUnit(VEIL_TEX_SPARSE_LIST, list_tex);
+        glBindTextureUnit(VEIL_TEX_OPV0, tex);
+        glBindImageTexture(VEIL_IMAGE_SPARSE_OUT, tex, 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+        int done = 0;
+        for (size_t k = 0; k < levels; ++k) { /* rank 0, the bricks nearest the light, first */
+            size_t m = first[k + 1] - first[k];
+            if (!m) continue;
+            glProgramUniform1i(p, glGetUniformLocation(p, "u_first"), (GLint)first[k]);
+            for (size_t g = 0; g < m; g += 65535) { /* GL's guaranteed work groups per dispatch */
+                if (g) glProgramUniform1i(p, glGetUniformLocation(p, "u_first"), (GLint)(first[k] + g));
+                glDispatchCompute((GLuint)(m - g < 65535 ? m - g : 65535), 1, 1);
+            }
+            glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+            ++done;
+        }
+        *passes = done > *passes ? done : *passes;
+        glBindImageTexture(VEIL_IMAGE_SPARSE_OUT, 0, 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glBindTextureUnit(VEIL_TEX_OPV0, 0);
+        glBindTextureUnit(VEIL_TEX_SPARSE_LIST, 0);
+        glBindTextureUnit(VEIL_TEX_EV, 0);
+        veil_ev_sparse_bind(NULL);
+        glUseProgram(0);
+        r = veil_gl_check("optical depth over a sparse volume (propagate/shaders/propagate_sparse.comp)", err);
     }
-    (void)g;
-    glUseProgram(p);
-    glProgramUniform4fv(p, glGetUniformLocation(p, "u_light"), 4, lights);
-    glProgramUniform1i(p, glGetUniformLocation(p, "u_count"), count);
-    veil_ev_sparse_bind(sp);
-    glBindTextureUnit(VEIL_TEX_EV, sp->atlas);
-    glBindImageTexture(VEIL_IMAGE_SPARSE_OUT, tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glDispatchCompute(veil_groups(sp->atlas_texels[0], VEIL_SPARSE_GROUP),
-                      veil_groups(sp->atlas_texels[1], VEIL_SPARSE_GROUP),
-                      veil_groups(sp->atlas_texels[2], VEIL_SPARSE_GROUP));
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-    glBindImageTexture(VEIL_IMAGE_SPARSE_OUT, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindTextureUnit(VEIL_TEX_EV, 0);
-    veil_ev_sparse_bind(NULL);
-    glUseProgram(0);
-    return veil_gl_check("optical depth over a sparse volume (propagate/shaders/propagate_sparse.comp)", err);
+    glDeleteTextures(1, &list_tex);
+    glDeleteBuffers(1, &buf);
+    free(first);
+    free(level);
+    free(list);
+    return r;
 }
 
 veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, uint64_t ev_key,
@@ -126,9 +211,9 @@ veil_result veil_opv_set_update_ev(veil_opv_set* s, const veil_grid* g, GLuint e
             continue;
         }
         r = texture_of(s, t, sp ? sp->atlas_texels : g->dims, sp ? "veil optical depth (sparse atlas)" : "veil optical-depth volume", err);
-        int it = sp ? 1 : 0;
+        int it = 0;
         s->key[t] = 0;
-        if (r == VEIL_OK && sp) r = sparse_depths(s, sp, g, ol, count, s->tex[t], err);
+        if (r == VEIL_OK && sp) r = sparse_depths(s, sp, ol, count, s->tex[t], &it, err);
         else if (r == VEIL_OK) r = veil_opv_gpu(&s->programs, g, ev, ol, count, params, &s->tex[t], &it, err);
         if (r == VEIL_OK) s->key[t] = key;
         rep->iterations = it > rep->iterations ? it : rep->iterations;

@@ -47,8 +47,10 @@ veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, 
 
 /* The same over an EV that may be sparse (sp: veil_ev_sparse_of, NULL for
  * dense): a sparse EV's textures are atlases laid out like its density's,
- * each texel's optical depth marched to the light
- * (propagate/shaders/propagate_sparse.comp; `params` only keys it). */
+ * each texel's optical depth marched through its brick and the empty
+ * bricks beyond, then read from the kept brick it enters, which an earlier
+ * pass did (bricks taken in the light's order: propagate/shaders/
+ * propagate_sparse.comp; `params` only keys it). rep->iterations: passes. */
 veil_result veil_opv_set_update_ev(veil_opv_set* s, const veil_grid* g, GLuint ev, const veil_ev_sparse* sp,
                                    uint64_t ev_key, const veil_light* lights, int n, const veil_opv_params* params,
                                    veil_opv_report* rep, veil_error* err);

@@ -186,7 +186,7 @@ veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, 
         d->keyed = 1, d->key = key;
         *field = d->field;
         memcpy(rep->dims, dims, sizeof rep->dims);
-        rep->cell = d->cell = 0.5f * (float)VEIL_BRICK * md->grid->voxel;
+        rep->cell = d->cell = (float)VEIL_BRICK / (VEIL_SPARSE_ESCAPE - 1) * md->grid->voxel;
         d->sparse = 1;
         return VEIL_OK;
     }

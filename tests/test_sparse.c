@@ -92,10 +92,11 @@ static float dense_sample(const float* d, const int dims[3], const float q[3])
     return sum;
 }
 
-/* The grid index of VDB index k on grid g (the file's lattice: index k at k * 0.05 m). */
+/* The grid index of VDB index k on grid g (the file's lattice: index k at
+ * k * 0.05 m; grid voxel j's centre at origin + (j + 0.5) voxel). */
 static int grid_index(const veil_grid* g, int a, int k)
 {
-    return (int)lround((double)k - (g->origin[a] / g->voxel - 0.5));
+    return (int)lround((double)k - (double)g->origin[a] / g->voxel - 0.5);
 }
 
 static void test_structure(void)
@@ -202,7 +203,8 @@ static void test_structure(void)
     veil_scene_free(&s);
 }
 
-/* The optical depth over the big file for a sun straight down: the path
+/* The optical depth over the big file for a sun straight down (and a
+ * point light straight above one column of voxel centres): the path
  * from voxel centre q goes up +y along a line of voxel centres, where the
  * trilinear field is linear between centres; the march's midpoint steps
  * (half a voxel, from q to brick faces that are centre planes too) then
@@ -241,7 +243,12 @@ static void test_depth(void)
     if (esp && set && sp.texels) {
         veil_opv_report orep;
         veil_opv_params params = {.method = VEIL_OPV_DEFAULT_METHOD};
-        CHECK(veil_opv_set_update_ev(set, &v.grid, veil_ev_texture(ev), esp, 1, s.lights, 1, &params, &orep, &err) ==
+        /* light 0: the scene's sun straight down; light 1: a point light 600 voxels above the crop, on
+         * the column of voxel centres x = 2000, z = 9, whose paths to it are vertical too */
+        veil_light lights[2] = {s.lights[0], {.type = VEIL_LIGHT_POINT, .position = {100.0f, 130.0f, 0.45f},
+                                              .color = {1, 1, 1}}};
+        int col_x = grid_index(&v.grid, 0, 2000), col_z = grid_index(&v.grid, 2, 9), top = grid_index(&v.grid, 1, 2600);
+        CHECK(veil_opv_set_update_ev(set, &v.grid, veil_ev_texture(ev), esp, 1, lights, 2, &params, &orep, &err) ==
                   VEIL_OK, "%s", err.msg);
         int t[3];
         veil_sparse_atlas_texels(&sp, t);
@@ -249,7 +256,7 @@ static void test_depth(void)
         float* D = malloc(n * 4 * sizeof *D);
         CHECK(D && veil_gl_read_texture(veil_opv_set_texture(set, 0), GL_RGBA, n * 4, D, "OD", &err) == VEIL_OK, "%s",
               err.msg);
-        long bad = 0, checked = 0;
+        long bad = 0, checked = 0, columns = 0;
         double worst = 0, rho_max = 0;
         for (size_t i = 0; i < n; ++i) rho_max = fmax(rho_max, sp.texels[i]);
         int side = t[0] > t[1] ? (t[0] > t[2] ? t[0] : t[2]) : (t[1] > t[2] ? t[1] : t[2]);
@@ -267,10 +274,14 @@ static void test_depth(void)
                     for (int x = 0; x < VEIL_SPARSE_APRON; ++x) {
                         int vox[3] = {b[0] * VEIL_BRICK + x, b[1] * VEIL_BRICK + y, b[2] * VEIL_BRICK + z};
                         if (vox[0] >= v.grid.dims[0] || vox[1] >= v.grid.dims[1] || vox[2] >= v.grid.dims[2]) continue;
-                        /* trapezoid over the voxels above, to the last centre of the box */
+                        /* trapezoid over the voxels above, to the last centre of the box (the sun)
+                         * or to the point light (its column) */
+                        int column = vox[0] == col_x && vox[2] == col_z;
+                        for (int light = 0; light < 1 + column; ++light) {
+                        int end = light ? top : v.grid.dims[1] - 1;
                         double want = 0.0;
                         int kept = 0;
-                        for (int yy = vox[1]; yy + 1 < v.grid.dims[1]; ++yy) {
+                        for (int yy = vox[1]; yy + 1 <= end; ++yy) {
                             int bb[3] = {vox[0] / VEIL_BRICK, yy / VEIL_BRICK, vox[2] / VEIL_BRICK};
                             int bn[3] = {vox[0] / VEIL_BRICK, (yy + 1) / VEIL_BRICK, vox[2] / VEIL_BRICK};
                             if (!veil_sparse_slot(&sp, bb) && !veil_sparse_slot(&sp, bn)) {
@@ -283,7 +294,8 @@ static void test_depth(void)
                         }
                         want *= v.grid.voxel;
                         double got = D[4 * ((size_t)(corner[0] + x) +
-                                            (size_t)t[0] * ((size_t)(corner[1] + y) + (size_t)t[1] * (size_t)(corner[2] + z)))];
+                                            (size_t)t[0] * ((size_t)(corner[1] + y) + (size_t)t[1] * (size_t)(corner[2] + z))) +
+                                       (size_t)light];
                         double e = fabs(got - want);
                         double tol = 1e-4 * want + 2.0 * kept * place * 0.5 * v.grid.voxel;
                         worst = fmax(worst, e / tol);
@@ -292,11 +304,15 @@ static void test_depth(void)
                                    y, z, got, want);
                         bad += !(e <= tol);
                         ++checked;
+                        columns += light;
+                        }
                     }
         }
-        CHECK(checked > 10000 && bad == 0, "%ld of %ld optical depths off the exact integral (worst %.3g of the bound)",
-              bad, checked, worst);
-        printf("optical depth: %ld texels of the crop's bricks, worst error %.3g of the bound\n", checked, worst);
+        CHECK(checked > 10000 && columns >= 18 && bad == 0,
+              "%ld of %ld optical depths off the exact integral (worst %.3g of the bound; %ld on the point light's column)",
+              bad, checked, worst, columns);
+        printf("optical depth: %ld texels of the crop's bricks (%ld for the point light), worst error %.3g of the bound\n",
+               checked, columns, worst);
         free(D);
     }
     veil_sparse_free(&sp);

@@ -49,6 +49,7 @@ void veil_ev_clear(veil_ev* ev)
         glDeleteTextures(1, &sp->coords);
         glDeleteBuffers(3, sp->buffers);
         glDeleteBuffers(1, &sp->ubo);
+        free(sp->bricks);
         memset(sp, 0, sizeof *sp);
         ev->is_sparse = 0;
     }
@@ -129,6 +130,8 @@ static veil_result build_sparse(veil_ev* ev, const veil_scene_volume* v, int n_l
     sp->slots = s.count;
     sp->bytes = veil_sparse_bytes(&s);
     sp->voxels = s.voxels;
+    sp->bricks = s.coords; /* kept: veil_sparse_free below leaves it */
+    s.coords = NULL;
     if (r == VEIL_OK) {
         ev->grid = v->grid;
         ev->present = 1;

@@ -47,6 +47,7 @@ typedef struct veil_ev_sparse {
     size_t slots;              /* bricks kept */
     size_t bytes;              /* GPU bytes of all of the above */
     size_t voxels;             /* non-zero voxels copied */
+    int32_t* bricks;           /* on the CPU too: 4 ints a slot (its brick), for ordering passes */
 } veil_ev_sparse;
 
 /* NULL for a dense EV (or none). */
