@@ -7,6 +7,7 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "io/vdb.h"
+#include "volume/scene_volume.h"
 
 static void print_info_grid(const veil_vdb_grid_info* g)
 {
@@ -32,8 +33,16 @@ static void print_info_grid(const veil_vdb_grid_info* g)
         for (int c = 0; c < 3; ++c) cubes &= r == c ? g->index_to_world[r][c] == s && s > 0.0 : g->index_to_world[r][c] == 0.0;
     if (!g->affine)
         printf("  rendering    not renderable: its transform is not affine\n");
-    else if (cubes)
-        printf("  rendering    native: axis-aligned %g m cubes, values copied (without medium.max_resolution)\n", s);
+    else if (cubes) {
+        /* the native grid: the index box and the support's ring of zeros */
+        double box = 1.0;
+        for (int a = 0; a < 3; ++a) box *= (double)g->index_hi[a] - g->index_lo[a] + 3;
+        if (g->active_voxels > 0 && box > (double)VEIL_NATIVE_MAX_VOXELS)
+            printf("  rendering    sparse: axis-aligned %g m cubes, a box of %.3g voxels (over the dense cap of 2^27): "
+                   "the 8^3 bricks that hold density, values copied (without medium.max_resolution)\n", s, box);
+        else
+            printf("  rendering    native: axis-aligned %g m cubes, values copied (without medium.max_resolution)\n", s);
+    }
     else
         printf("  rendering    resampled at its smallest voxel edge (the field at each voxel centre): its voxels are "
                "rotated or not cubes\n");

@@ -109,6 +109,10 @@ veil_result veil_plan_explain(const veil_scene* s, const veil_render_opts* opts,
     /* lights, then propagate */
     veil_light used[VEIL_MAX_LIGHTS];
     int n = veil_render_lights(s, g, used);
+    if (g && v.emission_count > 0 && s->multiple.emission_lights > 0 && n < VEIL_MAX_LIGHTS)
+        put(&t, "emission   up to %d point lights made at inject from the emission (multiple_scattering.emission_lights; "
+            "their textures are not counted below)\n", s->multiple.emission_lights < VEIL_MAX_LIGHTS - n
+                                                          ? s->multiple.emission_lights : VEIL_MAX_LIGHTS - n);
     int k = 0;
     for (size_t l = 0; l < s->light_count; ++l) {
         const veil_light* li = &s->lights[l];
@@ -127,7 +131,8 @@ veil_result veil_plan_explain(const veil_scene* s, const veil_render_opts* opts,
     } else {
         veil_opv_params params = veil_render_opv_params(s, o.method);
         put(&t, "propagate  frame 0: runs, %d light%s (%s), %d texture%s:", n, n == 1 ? "" : "s",
-            veil_opv_method_name(o.method), (n + 3) / 4, (n + 3) / 4 == 1 ? "" : "s");
+            v.sparse ? "sparse: brick by brick in the light's order" : veil_opv_method_name(o.method), (n + 3) / 4,
+            (n + 3) / 4 == 1 ? "" : "s");
         for (int tex = 0; 4 * tex < n; ++tex) {
             veil_opv_light ol[4];
             int count = n - 4 * tex < 4 ? n - 4 * tex : 4;

@@ -226,9 +226,12 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
     const char* method = sp ? "sparse: brick by brick in the light's order" : veil_opv_method_name(o->method);
     char from[64] = "";
     if (st->emission_lights) snprintf(from, sizeof from, " (+%d from the emission)", st->emission_lights);
+    const int* td = sp ? sp->atlas_texels : g->dims;
+    double mib = (double)td[0] * td[1] * td[2] * 16.0 * ((n + 3) / 4) / 1048576.0;
     if (orep.computed)
-        why(rep, "%d of %zu lights%s, %s, %d passes; %d textures computed (volume or light moved), %d cached",
-            n - st->emission_lights, s->light_count, from, method, orep.iterations, orep.computed, orep.cached);
+        why(rep, "%d of %zu lights%s, %s, %d passes; %d textures computed (volume or light moved), %d cached; "
+            "%.1f MiB", n - st->emission_lights, s->light_count, from, method, orep.iterations, orep.computed,
+            orep.cached, mib);
     else
         why(rep, "%d lights, %s: the volume, method and lights' geometry are unchanged", n, method);
     return res;

@@ -5,6 +5,9 @@
 //   make_test_vdbs DIR --big     also big_plume.vdb (~10^6 active voxels, for timing)
 //   make_test_vdbs --plume FILE  only the plume, at the size of big_plume.vdb, into FILE
 //   make_test_vdbs --pyro FILE   the base-size plume with a "temperature" grid (0..1), into FILE
+//   make_test_vdbs --pair A B    two overlapping plumes for a two-source scene (bench/vdb_import.py):
+//                                A the base plume (voxel 0.02 m), B a smaller one (voxel 0.03 m,
+//                                moved by (0.35, 0.5, 0.1) m: off A's lattice)
 //                                (the example scene data/scenes/vdb_smoke.json: `make data`)
 //
 // Files (grid name, what it is for):
@@ -322,8 +325,27 @@ int main(int argc, char** argv)
         std::printf("wrote %s\n", argv[2]);
         return 0;
     }
+    if (argc == 4 && std::strcmp(argv[1], "--pair") == 0) {
+        try {
+            openvdb::initialize();
+            FloatGrid::Ptr a = plume(1.0), b = plume(0.7);
+            b->setTransform(openvdb::math::Transform::createLinearTransform(0.03));
+            b->transform().postTranslate(openvdb::Vec3d(0.35, 0.5, 0.1));
+            for (int i = 0; i < 2; ++i) {
+                std::filesystem::path file(argv[2 + i]);
+                g_dir = file.has_parent_path() ? file.parent_path().string() : std::string(".");
+                std::filesystem::create_directories(g_dir);
+                write(file.filename().string().c_str(), {i ? b : a});
+            }
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "make_test_vdbs: %s\n", e.what());
+            return 1;
+        }
+        std::printf("wrote %s and %s\n", argv[2], argv[3]);
+        return 0;
+    }
     if (argc < 2 || argc > 3 || (argc == 3 && std::strcmp(argv[2], "--big") != 0)) {
-        std::fprintf(stderr, "usage: %s DIR [--big] | --plume FILE | --pyro FILE\n", argv[0]);
+        std::fprintf(stderr, "usage: %s DIR [--big] | --plume FILE | --pyro FILE | --pair A B\n", argv[0]);
         return 2;
     }
     g_dir = argv[1];
