@@ -211,7 +211,7 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
     veil_opv_params params = veil_render_opv_params(s, o->method);
     veil_opv_report orep = {0};
     const veil_ev_sparse* sp = veil_ev_sparse_of(r->ev);
-    veil_result res = veil_opv_set_update_ev(r->opv, g, veil_ev_texture(r->ev), sp, r->ev_key, lights, n, &params,
+    veil_result res = veil_opv_set_update(r->opv, g, veil_ev_texture(r->ev), sp, r->ev_key, lights, n, &params,
                                              &orep, err);
     st->opv_computed = orep.computed;
     st->opv_cached = orep.cached;

@@ -188,16 +188,9 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
     return r;
 }
 
-veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, uint64_t ev_key,
-                                const veil_light* lights, int n, const veil_opv_params* params, veil_opv_report* rep,
-                                veil_error* err)
-{
-    return veil_opv_set_update_ev(s, g, ev, NULL, ev_key, lights, n, params, rep, err);
-}
-
-veil_result veil_opv_set_update_ev(veil_opv_set* s, const veil_grid* g, GLuint ev, const veil_ev_sparse* sp,
-                                   uint64_t ev_key, const veil_light* lights, int n, const veil_opv_params* params,
-                                   veil_opv_report* rep, veil_error* err)
+veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, const veil_ev_sparse* sp,
+                                uint64_t ev_key, const veil_light* lights, int n, const veil_opv_params* params,
+                                veil_opv_report* rep, veil_error* err)
 {
     memset(rep, 0, sizeof *rep);
     veil_result r = VEIL_OK;

@@ -40,20 +40,15 @@ uint64_t veil_opv_texture_key(uint64_t ev_key, const veil_opv_params* params, co
 int veil_opv_set_has(const veil_opv_set* s, int t, uint64_t key);
 
 /* Brings the textures up to date for lights[0..n) of grid g over the EV
- * texture ev (of key ev_key). */
-veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, uint64_t ev_key,
-                                const veil_light* lights, int n, const veil_opv_params* params,
-                                veil_opv_report* rep, veil_error* err);
-
-/* The same over an EV that may be sparse (sp: veil_ev_sparse_of, NULL for
- * dense): a sparse EV's textures are atlases laid out like its density's,
+ * texture ev (of key ev_key). Over a sparse EV (sp: veil_ev_sparse_of;
+ * NULL for dense) the textures are atlases laid out like its density's,
  * each texel's optical depth marched through its brick and the empty
  * bricks beyond, then read from the kept brick it enters, which an earlier
  * pass did (bricks taken in the light's order: propagate/shaders/
- * propagate_sparse.comp; `params` only keys it). rep->iterations: passes. */
-veil_result veil_opv_set_update_ev(veil_opv_set* s, const veil_grid* g, GLuint ev, const veil_ev_sparse* sp,
-                                   uint64_t ev_key, const veil_light* lights, int n, const veil_opv_params* params,
-                                   veil_opv_report* rep, veil_error* err);
+ * propagate_sparse.comp; `params` only keys it); rep->iterations: passes. */
+veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, const veil_ev_sparse* sp,
+                                uint64_t ev_key, const veil_light* lights, int n, const veil_opv_params* params,
+                                veil_opv_report* rep, veil_error* err);
 
 /* Texture t (0 when none): VEIL_MAX_OPV_TEXTURES of them. */
 GLuint veil_opv_set_texture(const veil_opv_set* s, int t);
