@@ -10,7 +10,7 @@
 
 struct veil_march {
     GLuint program, program_emission, ubo; /* the march, and its variant with emission */
-    GLuint program_sparse;                 /* over a sparse volume, made when first needed */
+    GLuint program_sparse[2];              /* over a sparse volume (and with emission), made when first needed */
 };
 
 veil_result veil_march_create(veil_march** out, veil_error* err)
@@ -37,7 +37,8 @@ void veil_march_destroy(veil_march* m)
     if (!m) return;
     glDeleteProgram(m->program);
     glDeleteProgram(m->program_emission);
-    glDeleteProgram(m->program_sparse);
+    glDeleteProgram(m->program_sparse[0]);
+    glDeleteProgram(m->program_sparse[1]);
     glDeleteBuffers(1, &m->ubo);
     free(m);
 }
@@ -103,8 +104,9 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
     for (int l = 0; l < n; ++l) veil_gpu_light_from(&d->lights[l], &u->lights[l]);
     u->size[0] = d->width, u->size[1] = d->height, u->size[2] = n, u->size[3] = fogs;
     u->flags[0] = d->grid != NULL;
-    /* empty bricks hold no density but may glow: no skipping with emission */
-    u->flags[1] = d->grid != NULL && fogs == 0 && d->skip_empty && !d->emission;
+    /* empty bricks hold no density but may glow: no skipping with emission (a sparse volume's bricks
+     * not kept hold neither) */
+    u->flags[1] = d->grid != NULL && fogs == 0 && d->skip_empty && (!d->emission || d->sparse);
     u->limits[1] = d->grid != NULL && d->emission ? 1.0f : 0.0f;
     u->flags[2] = d->seed;
     u->flags[3] = d->end_distance != NULL;
@@ -160,12 +162,15 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
     if (r == VEIL_OK) {
         out->width = w, out->height = h;
         glNamedBufferSubData(m->ubo, 0, sizeof u, &u);
-        if (d->grid && d->sparse && !m->program_sparse)
-            r = veil_gpu_program_variant("render/shaders/march.comp", "#define VEIL_SPARSE 1\n", "sparse",
-                                         &m->program_sparse, err);
+        int e = d->emission != 0;
+        if (d->grid && d->sparse && !m->program_sparse[e])
+            r = veil_gpu_program_variant("render/shaders/march.comp",
+                                         e ? "#define VEIL_SPARSE 1\n#define VEIL_MARCH_EMISSION 1\n" : "#define VEIL_SPARSE 1\n",
+                                         e ? "sparse, emission" : "sparse", &m->program_sparse[e], err);
     }
     if (r == VEIL_OK) {
-        glUseProgram(d->grid && d->sparse ? m->program_sparse : d->grid && d->emission ? m->program_emission : m->program);
+        glUseProgram(d->grid && d->sparse ? m->program_sparse[d->emission != 0]
+                     : d->grid && d->emission ? m->program_emission : m->program);
         veil_ev_sparse_bind(d->grid ? d->sparse : NULL);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, m->ubo);
         glBindTextureUnit(VEIL_TEX_EV, d->grid ? d->ev : 0);

@@ -10,6 +10,9 @@
  * depth (GPU): the optical depth marched through the bricks equals the
  *   exact integral (a sun straight down: see the case).
  * render (GPU): the big file rendered sparse equals the crop rendered dense.
+ * emission (CPU, then GPU): emissive_slab.vdb's emission (a heat grid, and
+ *   the same read as temperature) sparse equals dense voxel for voxel, its
+ *   lights too, and so does the render.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -25,6 +28,7 @@
 #include "gpu/gl_util.h"
 #include "io/scene.h"
 #include "propagate/opv_set.h"
+#include "volume/emission_lights.h"
 #include "volume/ev.h"
 #include "volume/scene_volume.h"
 #include "volume/sparse.h"
@@ -248,7 +252,7 @@ static void test_depth(void)
         veil_light lights[2] = {s.lights[0], {.type = VEIL_LIGHT_POINT, .position = {100.0f, 130.0f, 0.45f},
                                               .color = {1, 1, 1}}};
         int col_x = grid_index(&v.grid, 0, 2000), col_z = grid_index(&v.grid, 2, 9), top = grid_index(&v.grid, 1, 2600);
-        CHECK(veil_opv_set_update_ev(set, &v.grid, veil_ev_texture(ev), esp, 1, lights, 2, &params, &orep, &err) ==
+        CHECK(veil_opv_set_update(set, &v.grid, veil_ev_texture(ev), esp, 1, lights, 2, &params, &orep, &err) ==
                   VEIL_OK, "%s", err.msg);
         int t[3];
         veil_sparse_atlas_texels(&sp, t);
@@ -385,6 +389,134 @@ static void test_render(void)
     veil_scene_free(&sb);
 }
 
+/* A scene of emissive_slab.vdb ("density" and "heat" 1 on a 20 x 20 x 10
+ * box of 0.1 m voxels) seen from above, its heat as `kind` ("emission" or
+ * "temperature"), lit by a sun straight down. */
+static veil_result slab_scene(const char* kind, const char* representation, int lights, veil_scene* s)
+{
+    char json[8192];
+    snprintf(json, sizeof json,
+             "{\"camera\": {\"position\": [0.95, 0.95, 6], \"look_at\": [0.95, 0.95, 0], \"fov_y_deg\": 22,"
+             " \"width\": 48, \"height\": 48},"
+             " \"medium\": {\"sigma_a\": [0.5, 1, 2], \"sigma_s\": [2, 2, 2], \"representation\": \"%s\","
+             "  \"sources\": [{\"type\": \"vdb\", \"file\": \"%s/emissive_slab.vdb\","
+             "   \"%s\": {\"grid\": \"heat\", \"scale\": %s}}]},"
+             " \"lights\": [{\"type\": \"directional\", \"direction\": [0, -1, 0], \"irradiance\": [1, 1, 1]}],"
+             " \"multiple_scattering\": {\"volumetric\": false, \"screen_space\": false, \"emission_lights\": %d}}",
+             representation, g_dir, kind, strcmp(kind, "temperature") ? "2" : "1500", lights);
+    veil_error err = {0};
+    veil_result r = veil_scene_parse("slab.json", json, strlen(json), s, &err);
+    if (r != VEIL_OK) fprintf(stderr, "%s\n", err.msg);
+    return r;
+}
+
+/* Sparse emission against dense: the same voxels' eps (the copy and the
+ * formula are the same: bit for bit), the same lights (the clusters do not
+ * depend on the order the voxels come in: to float rounding of the sums,
+ * 1e-6), and the same image (every sample point the same: the camera faces
+ * the box's top, no skipping; the sun's optical depth exact in both along
+ * its axis, the emission's lights left out here since their optical depth
+ * is not along an axis): 1e-4 of the brightest pixel, as test_render's
+ * rounding bound with emission's one more texture read per sample. */
+static void test_emission(void)
+{
+    static const char* const kinds[2] = {"emission", "temperature"};
+    for (int k = 0; k < 2; ++k) {
+        veil_scene ss, sd;
+        veil_scene_volume vs, vd;
+        veil_error err = {0};
+        memset(&vs, 0, sizeof vs);
+        memset(&vd, 0, sizeof vd);
+        if (slab_scene(kinds[k], "sparse", 8, &ss) != VEIL_OK || slab_scene(kinds[k], "dense", 8, &sd) != VEIL_OK ||
+            veil_scene_volume_open(&ss, &vs, &err) != VEIL_OK || veil_scene_volume_open(&sd, &vd, &err) != VEIL_OK) {
+            CHECK(0, "%s: %s", kinds[k], err.msg);
+            return;
+        }
+        CHECK(vs.sparse && !vd.sparse && !memcmp(&vs.grid, &vd.grid, sizeof vs.grid), "%s: grids", kinds[k]);
+        veil_sparse sp;
+        float* rgba = NULL;
+        CHECK(veil_sparse_build(&vs, 2048, &sp, &err) == VEIL_OK, "%s", err.msg);
+        CHECK(veil_scene_volume_emission(&vd, &rgba, &err) == VEIL_OK && rgba, "%s", err.msg);
+        long differ = 0, emitting = 0;
+        const int* d = vd.grid.dims;
+        for (int z = 0; z < d[2] && rgba && sp.emission_texels; ++z)
+            for (int y = 0; y < d[1]; ++y)
+                for (int x = 0; x < d[0]; ++x) {
+                    const float* want = rgba + 4 * ((size_t)x + (size_t)d[0] * ((size_t)y + (size_t)d[1] * (size_t)z));
+                    int b[3] = {x / VEIL_BRICK, y / VEIL_BRICK, z / VEIL_BRICK};
+                    uint32_t slot = veil_sparse_slot(&sp, b);
+                    float got[3] = {0, 0, 0};
+                    if (slot) {
+                        int t[3];
+                        veil_sparse_atlas_texels(&sp, t);
+                        size_t s = slot - 1;
+                        int c[3] = {(int)(s % (size_t)sp.atlas[0]) * VEIL_SPARSE_APRON + x % VEIL_BRICK,
+                                    (int)(s / (size_t)sp.atlas[0] % (size_t)sp.atlas[1]) * VEIL_SPARSE_APRON + y % VEIL_BRICK,
+                                    (int)(s / ((size_t)sp.atlas[0] * (size_t)sp.atlas[1])) * VEIL_SPARSE_APRON + z % VEIL_BRICK};
+                        memcpy(got, sp.emission_texels + 4 * ((size_t)c[0] + (size_t)t[0] * ((size_t)c[1] + (size_t)t[1] * (size_t)c[2])),
+                               sizeof got);
+                    }
+                    differ += got[0] != want[0] || got[1] != want[1] || got[2] != want[2];
+                    emitting += want[0] > 0.0f;
+                }
+        CHECK(differ == 0 && emitting == 4000, "%s: %ld voxels' emission differ (%ld emitting, 4000 expected)", kinds[k],
+              differ, emitting);
+        CHECK(sp.emitter_count == 4000, "%s: %zu emitters", kinds[k], sp.emitter_count);
+        /* the lights */
+        veil_light ld[VEIL_MAX_LIGHTS], ls[VEIL_MAX_LIGHTS];
+        int nd = 0, ns = 0;
+        CHECK(veil_emission_lights(&vd.grid, rgba, 8, ld, &nd, &err) == VEIL_OK, "%s", err.msg);
+        CHECK(veil_emission_lights_points(sp.emitters, sp.emitter_count, sp.grid.voxel, 8, ls, &ns, &err) == VEIL_OK,
+              "%s", err.msg);
+        CHECK(nd == 8 && ns == 8, "%s: %d and %d lights", kinds[k], nd, ns);
+        for (int i = 0; i < nd && i < ns; ++i)
+            for (int a = 0; a < 3; ++a) {
+                CHECK(fabsf(ld[i].position[a] - ls[i].position[a]) <= 1e-6f * (1.0f + fabsf(ld[i].position[a])),
+                      "%s: light %d position %g vs %g", kinds[k], i, ls[i].position[a], ld[i].position[a]);
+                CHECK(fabsf(ld[i].color[a] - ls[i].color[a]) <= 1e-6f * ld[i].color[a], "%s: light %d power %g vs %g",
+                      kinds[k], i, ls[i].color[a], ld[i].color[a]);
+            }
+        free(rgba);
+        veil_sparse_free(&sp);
+        veil_scene_volume_close(&vs);
+        veil_scene_volume_close(&vd);
+        veil_scene_free(&ss);
+        veil_scene_free(&sd);
+    }
+    /* the render */
+    veil_gl* gl = check_gpu_or_skip();
+    veil_renderer* r = NULL;
+    veil_error err = {0};
+    CHECK(veil_renderer_create(gl, &r, &err) == VEIL_OK, "%s", err.msg);
+    for (int k = 0; k < 2 && r; ++k) {
+        veil_scene ss, sd;
+        veil_image_set a = {0}, b = {0};
+        veil_render_stats st = {0};
+        veil_render_opts o = {.seed = 2, .no_skip = 1};
+        if (slab_scene(kinds[k], "sparse", 0, &ss) != VEIL_OK || slab_scene(kinds[k], "dense", 0, &sd) != VEIL_OK) {
+            CHECK(0, "scenes");
+            break;
+        }
+        CHECK(veil_render_scene_images(r, &sd, &o, &a, NULL, &err) == VEIL_OK, "%s", err.msg);
+        CHECK(veil_render_scene_images(r, &ss, &o, &b, &st, &err) == VEIL_OK, "%s", err.msg);
+        CHECK(strstr(st.stage[VEIL_STAGE_INJECT].why, "sparse: "), "%s", st.stage[VEIL_STAGE_INJECT].why);
+        if (a.rgba && b.rgba) {
+            double peak = 0, worst = 0;
+            for (int i = 0; i < a.width * a.height * 4; ++i)
+                if ((i & 3) != 3) peak = fmax(peak, a.rgba[i]), worst = fmax(worst, fabs((double)a.rgba[i] - b.rgba[i]));
+            printf("%s: sparse vs dense, peak %.4g, worst %.3g (%.2g of the peak)\n", kinds[k], peak, worst, worst / peak);
+            CHECK(peak > 0.1 && worst <= 1e-4 * peak, "%s: sparse and dense differ by %.3g (peak %.3g)", kinds[k], worst,
+                  peak);
+        }
+        veil_image_set_free(&a);
+        veil_image_set_free(&b);
+        veil_scene_free(&ss);
+        veil_scene_free(&sd);
+    }
+    veil_renderer_destroy(r);
+    veil_gl_destroy(gl);
+}
+
 int main(int argc, char** argv)
 {
     if (argc != 3) {
@@ -395,7 +527,7 @@ int main(int argc, char** argv)
     static const struct {
         const char* name;
         void (*fn)(void);
-    } cases[] = {{"structure", test_structure}, {"depth", test_depth}, {"render", test_render}};
+    } cases[] = {{"structure", test_structure}, {"depth", test_depth}, {"render", test_render}, {"emission", test_emission}};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i)
         if (strcmp(argv[2], cases[i].name) == 0) {
             cases[i].fn();

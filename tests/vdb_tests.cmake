@@ -53,7 +53,7 @@ add_executable(test_sparse ${CMAKE_CURRENT_SOURCE_DIR}/test_sparse.c ${CMAKE_CUR
 target_link_libraries(test_sparse PRIVATE veil veil_fp veil_warnings)
 add_test(NAME sparse_structure COMMAND test_sparse ${VDB_DATA} structure)
 set_tests_properties(sparse_structure PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "unit;accuracy")
-foreach(case depth render)
+foreach(case depth render emission)
   add_test(NAME sparse_${case} COMMAND test_sparse ${VDB_DATA} ${case})
   set_tests_properties(sparse_${case} PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "gpu;accuracy" SKIP_RETURN_CODE 77)
 endforeach()

@@ -18,36 +18,65 @@ typedef struct cluster {
     double weight;
 } cluster;
 
+/* By the split's coordinate, then the whole position: a total order (voxels
+ * differ in position), so the clusters do not depend on the input's order. */
 static int by_key(const void* a, const void* b)
 {
-    float x = ((const emitter*)a)->key, y = ((const emitter*)b)->key;
-    return (x > y) - (x < y);
+    const emitter *p = a, *q = b;
+    if (p->key != q->key) return (p->key > q->key) - (p->key < q->key);
+    for (int i = 0; i < 3; ++i)
+        if (p->p[i] != q->p[i]) return (p->p[i] > q->p[i]) - (p->p[i] < q->p[i]);
+    return 0;
 }
 
 veil_result veil_emission_lights(const veil_grid* g, const float* rgba, int max, veil_light* out, int* n,
                                  veil_error* err)
 {
     *n = 0;
-    if (max > VEIL_MAX_LIGHTS) max = VEIL_MAX_LIGHTS;
     if (!rgba || max < 1) return VEIL_OK;
     size_t voxels = veil_grid_voxels(g), count = 0;
     double dv = (double)g->voxel * g->voxel * g->voxel;
     for (size_t i = 0; i < voxels; ++i)
         count += VEIL_LUM_R * rgba[4 * i] + VEIL_LUM_G * rgba[4 * i + 1] + VEIL_LUM_B * rgba[4 * i + 2] > 0.0;
     if (count == 0) return VEIL_OK;
-    emitter* em = malloc(count * sizeof *em);
-    if (!em) return veil_fail(err, VEIL_ERR_OOM, "out of memory for %zu emitting voxels", count);
+    float* pts = malloc(count * 6 * sizeof *pts);
+    if (!pts) return veil_fail(err, VEIL_ERR_OOM, "out of memory for %zu emitting voxels", count);
     size_t k = 0;
     for (size_t i = 0; i < voxels; ++i) {
         const float* e = rgba + 4 * i;
-        double lum = VEIL_LUM_R * e[0] + VEIL_LUM_G * e[1] + VEIL_LUM_B * e[2];
-        if (!(lum > 0.0)) continue;
+        if (!(VEIL_LUM_R * e[0] + VEIL_LUM_G * e[1] + VEIL_LUM_B * e[2] > 0.0)) continue;
         int x = (int)(i % (size_t)g->dims[0]), y = (int)(i / (size_t)g->dims[0] % (size_t)g->dims[1]),
             z = (int)(i / ((size_t)g->dims[0] * (size_t)g->dims[1]));
-        veil_grid_center(g, x, y, z, em[k].p);
-        em[k].w = (float)(lum * dv);
-        for (int c = 0; c < 3; ++c) em[k].e[c] = (float)(e[c] * dv);
+        veil_grid_center(g, x, y, z, pts + 6 * k);
+        for (int c = 0; c < 3; ++c) pts[6 * k + 3 + (size_t)c] = (float)(e[c] * dv);
         ++k;
+    }
+    veil_result r = veil_emission_lights_points(pts, count, g->voxel, max, out, n, err);
+    free(pts);
+    return r;
+}
+
+veil_result veil_emission_lights_points(const float* pts, size_t count, float voxel, int max, veil_light* out, int* n,
+                                        veil_error* err)
+{
+    *n = 0;
+    if (max > VEIL_MAX_LIGHTS) max = VEIL_MAX_LIGHTS;
+    if (count == 0 || max < 1) return VEIL_OK;
+    emitter* em = malloc(count * sizeof *em);
+    if (!em) return veil_fail(err, VEIL_ERR_OOM, "out of memory for %zu emitting voxels", count);
+    size_t k = 0;
+    for (size_t i = 0; i < count; ++i) {
+        const float* e = pts + 6 * i + 3;
+        double lum = VEIL_LUM_R * e[0] + VEIL_LUM_G * e[1] + VEIL_LUM_B * e[2];
+        if (!(lum > 0.0)) continue;
+        for (int a = 0; a < 3; ++a) em[k].p[a] = pts[6 * i + (size_t)a], em[k].e[a] = e[a];
+        em[k].w = (float)lum;
+        ++k;
+    }
+    count = k;
+    if (count == 0) {
+        free(em);
+        return VEIL_OK;
     }
     cluster cl[VEIL_MAX_LIGHTS];
     cl[0] = (cluster){0, count, 0.0};
@@ -94,7 +123,7 @@ veil_result veil_emission_lights(const veil_grid* g, const float* rgba, int max,
          * its volume, radius 0.62 h: (3/5) 0.62^2 h^2) adds to its centres' (a union's second moment is
          * the sum); a ball's mean intensity at its centre, eps R, equals a point's I / (4 pi r^2) at
          * r = R / sqrt(3) = sqrt(5/9) RMS (R^2 = (5/3) RMS^2, I = (4/3) pi R^3 eps) */
-        double h = g->voxel, rms2 = r2 / w + 0.6 * pow(3.0 / (4.0 * VEIL_PI), 2.0 / 3.0) * h * h;
+        double h = voxel, rms2 = r2 / w + 0.6 * pow(3.0 / (4.0 * VEIL_PI), 2.0 / 3.0) * h * h;
         l->radius = (float)sqrt(5.0 / 9.0 * rms2);
     }
     free(em);

@@ -27,4 +27,10 @@
 veil_result veil_emission_lights(const veil_grid* g, const float* rgba, int max, veil_light* out, int* n,
                                  veil_error* err);
 
+/* The same from a list of emitting voxels: 6 floats each, the voxel's
+ * centre (m) and eps dV per channel (W/sr), voxels of edge `voxel` (m).
+ * The clusters depend on the voxels, not on their order in the list. */
+veil_result veil_emission_lights_points(const float* pts, size_t count, float voxel, int max, veil_light* out, int* n,
+                                        veil_error* err);
+
 #endif

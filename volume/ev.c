@@ -102,12 +102,15 @@ static veil_result build_sparse(veil_ev* ev, const veil_scene_volume* v, int n_l
     ev->is_sparse = 1;
     veil_sparse_atlas_texels(&s, sp->atlas_texels);
     size_t texels = (size_t)sp->atlas_texels[0] * (size_t)sp->atlas_texels[1] * (size_t)sp->atlas_texels[2];
-    /* the optical depths: an rgba32f atlas per 4 lights (veil_ev_check_budget's count for dense) */
-    unsigned long long total = veil_sparse_bytes(&s) + (unsigned long long)texels * 16 * (unsigned long long)((n_lights + 3) / 4);
+    /* the optical depths: an rgba32f atlas per 4 lights (veil_ev_check_budget's count for dense); the
+     * emission's lights join the scene's */
+    int lights = n_lights + (s.emitter_count ? v->emission_lights : 0);
+    if (lights > VEIL_MAX_LIGHTS) lights = VEIL_MAX_LIGHTS;
+    unsigned long long total = veil_sparse_bytes(&s) + (unsigned long long)texels * 16 * (unsigned long long)((lights + 3) / 4);
     if (total > budget)
         r = veil_fail(err, VEIL_ERR_LIMIT,
                       "a sparse volume of %zu bricks with %d lights needs %.0f MiB of textures, more than the %.0f MiB "
-                      "allowed on this device; set medium.max_resolution", s.count, n_lights,
+                      "allowed on this device; set medium.max_resolution", s.count, lights,
                       (double)total / 1048576.0, (double)budget / 1048576.0);
     if (r == VEIL_OK) r = veil_gl_texture3d(GL_R32F, sp->atlas_texels, "veil sparse atlas", &ev->tex, err);
     if (r == VEIL_OK) {
@@ -115,6 +118,17 @@ static veil_result build_sparse(veil_ev* ev, const veil_scene_volume* v, int n_l
                             GL_FLOAT, s.texels);
         r = veil_gl_check("uploading the sparse atlas", err);
     }
+    if (r == VEIL_OK && s.emission_texels) {
+        r = veil_gl_texture3d(GL_RGBA32F, sp->atlas_texels, "veil sparse emission atlas", &ev->emission, err);
+        if (r == VEIL_OK) {
+            glTextureSubImage3D(ev->emission, 0, 0, 0, 0, sp->atlas_texels[0], sp->atlas_texels[1], sp->atlas_texels[2],
+                                GL_RGBA, GL_FLOAT, s.emission_texels);
+            r = veil_gl_check("uploading the sparse emission atlas", err);
+        }
+    }
+    if (r == VEIL_OK)
+        r = veil_emission_lights_points(s.emitters, s.emitter_count, s.grid.voxel, v->emission_lights, ev->lights,
+                                        &ev->light_count, err);
     size_t top = (size_t)s.top[0] * (size_t)s.top[1] * (size_t)s.top[2];
     if (r == VEIL_OK)
         r = buffer_texture(GL_R32UI, top * 4, s.top_table, "veil sparse top table", &sp->buffers[0], &sp->top, err);

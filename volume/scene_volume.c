@@ -112,6 +112,30 @@ static void blackbody(const double (*table)[3], double kelvin, double rgb[3])
     for (int c = 0; c < 3; ++c) rgb[c] = table[i][c] + f * (table[i + 1][c] - table[i][c]);
 }
 
+double* veil_emission_table(void)
+{
+    double* table = malloc(BB_ENTRIES * 3 * sizeof *table);
+    for (int t = 0; table && t < BB_ENTRIES; ++t) veil_blackbody_rgb(t * BB_STEP, table + 3 * t);
+    return table;
+}
+
+void veil_emission_eps(const veil_scene_volume* v, const veil_emission_source* es, const double* table, float value,
+                       float rho, float eps[3])
+{
+    if (!es->temperature) {
+        for (int c = 0; c < 3; ++c) eps[c] = es->factor[c] * value;
+        return;
+    }
+    eps[0] = eps[1] = eps[2] = 0.0f;
+    if (!(rho > 0.0f)) return;
+    double bb[3];
+    blackbody((const double(*)[3])table, (double)es->t_scale * value + es->t_offset, bb);
+    for (int c = 0; c < 3; ++c) {
+        double kc = es->factor[c] >= 0.0f ? es->factor[c] : v->sigma_a[c];
+        eps[c] = (float)(kc * rho * bb[c]);
+    }
+}
+
 veil_result veil_scene_volume_emission(const veil_scene_volume* v, float** rgba, veil_error* err)
 {
     *rgba = NULL;
@@ -120,34 +144,21 @@ veil_result veil_scene_volume_emission(const veil_scene_volume* v, float** rgba,
     float* out = calloc(n * 4, sizeof *out);
     float* one = malloc(n * sizeof *one);
     float* rho = malloc(n * sizeof *rho);
-    double(*table)[3] = malloc(BB_ENTRIES * sizeof *table);
+    double* table = veil_emission_table();
     veil_result r = out && one && rho && table ? VEIL_OK
                                                : veil_fail(err, VEIL_ERR_OOM, "out of memory for a %zu-voxel emission", n);
-    int tabulated = 0;
     for (int i = 0; i < v->emission_count && r == VEIL_OK; ++i) {
         const veil_emission_source* es = &v->emission[i];
         memset(one, 0, n * sizeof *one);
         r = veil_vdb_to_grid(es->grid, 1.0f, &v->grid, one, err);
-        if (r != VEIL_OK) break;
-        if (!es->temperature) {
-            for (size_t k = 0; k < n; ++k)
-                for (int c = 0; c < 3; ++c) out[4 * k + (size_t)c] += es->factor[c] * one[k];
-            continue;
+        if (r == VEIL_OK && es->temperature) {
+            memset(rho, 0, n * sizeof *rho);
+            r = veil_vdb_to_grid(v->vdbs[es->density], v->vdb_scale[es->density], &v->grid, rho, err);
         }
-        if (!tabulated) {
-            for (int t = 0; t < BB_ENTRIES; ++t) veil_blackbody_rgb(t * BB_STEP, table[t]);
-            tabulated = 1;
-        }
-        memset(rho, 0, n * sizeof *rho);
-        r = veil_vdb_to_grid(v->vdbs[es->density], v->vdb_scale[es->density], &v->grid, rho, err);
         for (size_t k = 0; k < n && r == VEIL_OK; ++k) {
-            if (!(rho[k] > 0.0f)) continue;
-            double bb[3];
-            blackbody((const double(*)[3])table, (double)es->t_scale * one[k] + es->t_offset, bb);
-            for (int c = 0; c < 3; ++c) {
-                double kc = es->factor[c] >= 0.0f ? es->factor[c] : v->sigma_a[c];
-                out[4 * k + (size_t)c] += (float)(kc * rho[k] * bb[c]);
-            }
+            float eps[3];
+            veil_emission_eps(v, es, table, one[k], es->temperature ? rho[k] : 0.0f, eps);
+            for (int c = 0; c < 3; ++c) out[4 * k + (size_t)c] += eps[c];
         }
     }
     free(one);
@@ -289,16 +300,21 @@ static void sparse_obstacle(const veil_scene* s, const veil_scene_volume* v, cha
         snprintf(why, len, "the medium has RBF particles (splatted into a dense grid)");
     else if (v->vdb_count == 0)
         snprintf(why, len, "the medium has no vdb source");
-    else if (v->emission_count > 0)
-        snprintf(why, len, "a vdb source has an emission or temperature grid (dense only)");
     if (why[0]) return;
+    int temperature = 0;
+    for (int i = 0; i < v->emission_count; ++i) temperature |= v->emission[i].temperature;
+    if (temperature && v->vdb_count > 1) {
+        snprintf(why, len, "a temperature grid with several vdb sources (dense only)");
+        return;
+    }
     double edge0 = 0, origin0[3] = {0, 0, 0};
-    for (int i = 0; i < v->vdb_count; ++i) {
+    for (int i = 0; i < v->vdb_count + v->emission_count; ++i) {
+        const veil_vdb* grid = i < v->vdb_count ? v->vdbs[i] : v->emission[i - v->vdb_count].grid;
         double e, o[3];
         int al;
-        if (!veil_vdb_lattice(v->vdbs[i], &e, o, &al)) continue; /* no active voxel: adds nothing */
+        if (!veil_vdb_lattice(grid, &e, o, &al)) continue; /* no active voxel: adds nothing */
         if (!al) {
-            snprintf(why, len, "%s: its voxels are rotated or not cubes", veil_vdb_path(v->vdbs[i]));
+            snprintf(why, len, "%s: its voxels are rotated or not cubes", veil_vdb_path(grid));
             return;
         }
         if (edge0 == 0) {
@@ -312,7 +328,8 @@ static void sparse_obstacle(const veil_scene* s, const veil_scene_volume* v, cha
             on = fabs(k - floor(k + 0.5)) <= VEIL_VDB_ALIGN_TOL;
         }
         if (!on) {
-            snprintf(why, len, "%s: its voxels are not on the lattice of %s", veil_vdb_path(v->vdbs[i]),
+            snprintf(why, len, "%s%s%s: its voxels are not on the lattice of %s", veil_vdb_path(grid),
+                     i < v->vdb_count ? "" : ", grid ", i < v->vdb_count ? "" : veil_vdb_grid_name(grid),
                      veil_vdb_path(v->vdbs[0]));
             return;
         }

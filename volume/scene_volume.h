@@ -65,6 +65,15 @@ typedef struct veil_scene_volume {
  * there is none. */
 veil_result veil_scene_volume_emission(const veil_scene_volume* v, float** rgba, veil_error* err);
 
+/* What that adds per voxel, for the sparse volume too: eps (W m^-3 sr^-1)
+ * of emission source es where its grid reads `value` and its density is
+ * rho (a temperature grid emits only where rho > 0), with the blackbody
+ * table of veil_emission_table (3 doubles every 10 K to 20 000 K; malloc'd,
+ * NULL out of memory). */
+double* veil_emission_table(void);
+void veil_emission_eps(const veil_scene_volume* v, const veil_emission_source* es, const double* table, float value,
+                       float rho, float eps[3]);
+
 /* Native resolution. When the scene gives no medium.max_resolution and has
  * VDB sources, the grid takes the finest VDB voxel edge (not the default
  * 128 voxels), placed on the lattice of the first VDB with that edge whose

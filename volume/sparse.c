@@ -19,6 +19,11 @@ typedef struct gather {
     uint32_t* slots;
     size_t cap;      /* a power of two */
     float* data;     /* 512 floats a slot, x fastest */
+    float* edata;    /* with emission: 3 x 512 floats a slot, eps per channel, channel-major per slot */
+    float* one;      /* with emission: 512 floats a slot, one emission grid's values while it is read */
+    int emission;    /* 1: edata and one are kept */
+    int create;      /* 1: a voxel of a brick not kept makes it (0: only kept bricks take values) */
+    float* into;     /* what add_voxel adds to: data or one */
     int32_t* coords; /* 4 ints a slot */
     size_t count, data_cap;
     int bricks[3], dims[3];
@@ -89,12 +94,24 @@ static long long get(gather* g, const int b[3])
             float* d = realloc(g->data, cap * B * B * B * sizeof *d);
             if (!d) return -1;
             g->data = d;
+            if (g->emission) {
+                float* e = realloc(g->edata, cap * 3 * B * B * B * sizeof *e);
+                if (!e) return -1;
+                g->edata = e;
+                float* o = realloc(g->one, cap * B * B * B * sizeof *o);
+                if (!o) return -1;
+                g->one = o;
+            }
             int32_t* c = realloc(g->coords, cap * 4 * sizeof *c);
             if (!c) return -1;
             g->coords = c;
             g->data_cap = cap;
         }
         memset(g->data + g->count * B * B * B, 0, B * B * B * sizeof *g->data);
+        if (g->emission) {
+            memset(g->edata + g->count * 3 * B * B * B, 0, 3 * B * B * B * sizeof *g->edata);
+            memset(g->one + g->count * B * B * B, 0, B * B * B * sizeof *g->one);
+        }
         for (int a = 0; a < 3; ++a) g->coords[4 * g->count + a] = b[a];
         g->coords[4 * g->count + 3] = 0;
         g->keys[i] = key, g->slots[i] = (uint32_t)g->count++;
@@ -112,14 +129,22 @@ static void add_voxel(void* user, const int ijk[3], float value)
         if (t[a] < 0 || t[a] >= g->dims[a]) return; /* the grid covers every support: not reached */
         b[a] = t[a] / B;
     }
-    long long s = get(g, b);
-    if (s < 0) {
-        g->oom = 1;
-        return;
+    long long s;
+    if (g->create) {
+        s = get(g, b);
+        if (s < 0) {
+            g->oom = 1;
+            return;
+        }
+    } else {
+        uint32_t k = find(g, b);
+        if (!k) return;
+        s = (long long)k - 1;
     }
-    g->data[(size_t)s * B * B * B + (size_t)(t[0] % B) + B * ((size_t)(t[1] % B) + B * (size_t)(t[2] % B))] +=
+    float* into = g->into ? g->into : g->data;
+    into[(size_t)s * B * B * B + (size_t)(t[0] % B) + B * ((size_t)(t[1] % B) + B * (size_t)(t[2] % B))] +=
         g->scale * value;
-    ++g->voxels;
+    g->voxels += into == g->data;
 }
 
 /* The voxel at grid index t: 0 outside the grid or in a brick not kept. */
@@ -135,23 +160,68 @@ static float voxel_at(const gather* g, const int t[3])
     return g->data[(size_t)(s - 1) * B * B * B + (size_t)(t[0] % B) + B * ((size_t)(t[1] % B) + B * (size_t)(t[2] % B))];
 }
 
+/* The emission at grid index t into eps (0 where voxel_at is 0 too). */
+static void emission_at(const gather* g, const int t[3], float eps[3])
+{
+    eps[0] = eps[1] = eps[2] = 0.0f;
+    int b[3];
+    for (int a = 0; a < 3; ++a) {
+        if (t[a] < 0 || t[a] >= g->dims[a]) return;
+        b[a] = t[a] / B;
+    }
+    uint32_t s = find(g, b);
+    if (!s) return;
+    size_t k = (size_t)(t[0] % B) + B * ((size_t)(t[1] % B) + B * (size_t)(t[2] % B));
+    for (int c = 0; c < 3; ++c) eps[c] = g->edata[(size_t)(s - 1) * 3 * B * B * B + (size_t)c * B * B * B + k];
+}
+
+static veil_result offset_of(const veil_scene_volume* v, const veil_vdb* vdb, int off[3], veil_error* err);
+
+/* Adds the scene's emission sources to the bricks: each grid's values read
+ * into `one` (an emission grid makes the bricks it reaches; a temperature
+ * grid emits only where there is density, so only kept bricks take it),
+ * then eps per voxel as the dense path forms it (veil_emission_eps). */
+static veil_result gather_emission(const veil_scene_volume* v, gather* g, veil_error* err)
+{
+    double* table = veil_emission_table();
+    if (!table) return veil_fail(err, VEIL_ERR_OOM, "out of memory for the blackbody table");
+    veil_result r = VEIL_OK;
+    for (int i = 0; i < v->emission_count && r == VEIL_OK; ++i) {
+        const veil_emission_source* es = &v->emission[i];
+        memset(g->one, 0, g->count * B * B * B * sizeof *g->one);
+        g->into = g->one, g->scale = 1.0f, g->create = !es->temperature, g->last_key = 0;
+        r = offset_of(v, es->grid, g->off, err);
+        if (r == VEIL_OK) r = veil_vdb_each_voxel(es->grid, add_voxel, g, err);
+        if (r == VEIL_OK && g->oom) r = veil_fail(err, VEIL_ERR_OOM, "out of memory for the sparse volume's bricks");
+        for (size_t s = 0; s < g->count && r == VEIL_OK; ++s)
+            for (size_t k = 0; k < B * B * B; ++k) {
+                float eps[3];
+                veil_emission_eps(v, es, table, g->one[s * B * B * B + k], g->data[s * B * B * B + k], eps);
+                for (int c = 0; c < 3; ++c) g->edata[s * 3 * B * B * B + (size_t)c * B * B * B + k] += eps[c];
+            }
+    }
+    g->into = NULL, g->create = 1, g->last_key = 0;
+    free(table);
+    return r;
+}
+
 /* The whole-voxel offset of VDB i on the grid (VEIL_ERR_INVALID when its
  * voxels do not lie on the grid's: volume/scene_volume.c checks first). */
-static veil_result offset_of(const veil_scene_volume* v, int i, int off[3], veil_error* err)
+static veil_result offset_of(const veil_scene_volume* v, const veil_vdb* vdb, int off[3], veil_error* err)
 {
     double edge, origin[3];
     int aligned;
     const veil_grid* g = &v->grid;
-    if (!veil_vdb_lattice(v->vdbs[i], &edge, origin, &aligned) || !aligned ||
+    if (!veil_vdb_lattice(vdb, &edge, origin, &aligned) || !aligned ||
         fabs(edge - g->voxel) > VEIL_VDB_ALIGN_TOL * g->voxel)
-        return veil_fail(err, VEIL_ERR_INVALID, "%s: its voxels are not the sparse grid's", veil_vdb_path(v->vdbs[i]));
+        return veil_fail(err, VEIL_ERR_INVALID, "%s: its voxels are not the sparse grid's", veil_vdb_path(vdb));
     for (int a = 0; a < 3; ++a) {
         /* VDB index k sits at origin + k edge; grid voxel j's centre at g->origin + (j + 0.5) voxel */
         double o = (origin[a] - g->origin[a]) / g->voxel - 0.5;
         double r = floor(o + 0.5);
         if (fabs(o - r) > 4 * VEIL_VDB_ALIGN_TOL)
             return veil_fail(err, VEIL_ERR_INVALID, "%s: its voxels are off the sparse grid's by %.3g voxel",
-                             veil_vdb_path(v->vdbs[i]), fabs(o - r));
+                             veil_vdb_path(vdb), fabs(o - r));
         off[a] = (int)r;
     }
     return VEIL_OK;
@@ -164,6 +234,8 @@ void veil_sparse_free(veil_sparse* s)
     free(s->nodes);
     free(s->coords);
     free(s->texels);
+    free(s->emission_texels);
+    free(s->emitters);
     memset(s, 0, sizeof *s);
 }
 
@@ -177,7 +249,7 @@ size_t veil_sparse_bytes(const veil_sparse* s)
     int t[3];
     veil_sparse_atlas_texels(s, t);
     size_t top = (size_t)s->top[0] * (size_t)s->top[1] * (size_t)s->top[2];
-    return (size_t)t[0] * (size_t)t[1] * (size_t)t[2] * sizeof(float) + top * 4 +
+    return (size_t)t[0] * (size_t)t[1] * (size_t)t[2] * (s->emission_texels ? 5 : 1) * sizeof(float) + top * 4 +
            s->node_count * VEIL_SPARSE_NODE_BRICKS * 4 + s->count * 16;
 }
 
@@ -256,7 +328,10 @@ static veil_result dilate(gather* g, veil_error* err)
             for (int y = 0; y < B; ++y)
                 for (int x = 0; x < B; ++x) {
                     if (x && y && z) continue;
-                    if (d[x + B * (y + B * z)] == 0.0f) continue;
+                    size_t k = (size_t)(x + B * (y + B * z));
+                    const float* e = g->emission ? g->edata + s * 3 * B * B * B + k : NULL;
+                    if (d[k] == 0.0f && (!e || (e[0] == 0.0f && e[B * B * B] == 0.0f && e[2 * B * B * B] == 0.0f)))
+                        continue;
                     unsigned m = (x == 0) | (y == 0) << 1 | (z == 0) << 2;
                     for (unsigned bits = 1; bits < 8; ++bits)
                         if ((bits & m) == bits) need |= 1u << bits;
@@ -311,7 +386,7 @@ veil_result veil_sparse_build(const veil_scene_volume* v, int max_side, veil_spa
         out->bricks[a] = (grid->dims[a] + B - 1) / B;
         out->top[a] = (out->bricks[a] + N - 1) / N;
     }
-    gather g = {.cap = 1 << 12};
+    gather g = {.cap = 1 << 12, .create = 1, .emission = v->emission_count > 0};
     memcpy(g.bricks, out->bricks, sizeof g.bricks);
     memcpy(g.dims, grid->dims, sizeof g.dims);
     g.keys = calloc(g.cap, sizeof *g.keys);
@@ -319,12 +394,13 @@ veil_result veil_sparse_build(const veil_scene_volume* v, int max_side, veil_spa
     veil_result r = g.keys && g.slots ? VEIL_OK : veil_fail(err, VEIL_ERR_OOM, "out of memory for the sparse volume");
     for (int i = 0; i < v->vdb_count && r == VEIL_OK; ++i) {
         if (!(v->vdb_scale[i] > 0.0f)) continue;
-        r = offset_of(v, i, g.off, err);
+        r = offset_of(v, v->vdbs[i], g.off, err);
         g.scale = v->vdb_scale[i];
         g.last_key = 0;
         if (r == VEIL_OK) r = veil_vdb_each_voxel(v->vdbs[i], add_voxel, &g, err);
         if (r == VEIL_OK && g.oom) r = veil_fail(err, VEIL_ERR_OOM, "out of memory for the sparse volume's bricks");
     }
+    if (r == VEIL_OK && g.emission) r = gather_emission(v, &g, err);
     if (r == VEIL_OK) r = dilate(&g, err);
     /* the atlas: a near-square slab of bricks */
     int per = max_side / A;
@@ -345,6 +421,10 @@ veil_result veil_sparse_build(const veil_scene_volume* v, int max_side, veil_spa
         size_t n = (size_t)t[0] * (size_t)t[1] * (size_t)t[2];
         out->texels = calloc(n, sizeof *out->texels);
         if (!out->texels) r = veil_fail(err, VEIL_ERR_OOM, "out of memory for a %zu-texel atlas", n);
+        if (r == VEIL_OK && g.emission) {
+            out->emission_texels = calloc(n * 4, sizeof *out->emission_texels);
+            if (!out->emission_texels) r = veil_fail(err, VEIL_ERR_OOM, "out of memory for a %zu-texel emission atlas", n);
+        }
         for (size_t s = 0; s < g.count && r == VEIL_OK; ++s) {
             int corner[3] = {(int)(s % (size_t)out->atlas[0]) * A, (int)(s / (size_t)out->atlas[0] % (size_t)out->atlas[1]) * A,
                              (int)(s / ((size_t)out->atlas[0] * (size_t)out->atlas[1])) * A};
@@ -355,9 +435,32 @@ veil_result veil_sparse_build(const veil_scene_volume* v, int max_side, veil_spa
                         int vox[3] = {B * b[0] + x, B * b[1] + y, B * b[2] + z};
                         float value = x < B && y < B && z < B ? g.data[s * B * B * B + (size_t)(x + B * (y + B * z))]
                                                               : voxel_at(&g, vox);
-                        out->texels[(size_t)(corner[0] + x) +
-                                    (size_t)t[0] * ((size_t)(corner[1] + y) + (size_t)t[1] * (size_t)(corner[2] + z))] = value;
+                        size_t at = (size_t)(corner[0] + x) +
+                                    (size_t)t[0] * ((size_t)(corner[1] + y) + (size_t)t[1] * (size_t)(corner[2] + z));
+                        out->texels[at] = value;
+                        if (out->emission_texels) emission_at(&g, vox, out->emission_texels + 4 * at);
                     }
+        }
+    }
+    /* the emitting voxels, for the emission's lights (volume/emission_lights.h) */
+    size_t emitting = 0;
+    for (size_t k = 0; r == VEIL_OK && g.emission && k < g.count * B * B * B; ++k) {
+        const float* e = g.edata + (k / (B * B * B)) * 3 * B * B * B + k % (B * B * B);
+        emitting += VEIL_LUM_R * e[0] + VEIL_LUM_G * e[B * B * B] + VEIL_LUM_B * e[2 * B * B * B] > 0.0;
+    }
+    if (emitting) {
+        out->emitters = malloc(emitting * 6 * sizeof *out->emitters);
+        if (!out->emitters) r = veil_fail(err, VEIL_ERR_OOM, "out of memory for %zu emitting voxels", emitting);
+        double dv = (double)grid->voxel * grid->voxel * grid->voxel;
+        for (size_t k = 0; r == VEIL_OK && k < g.count * B * B * B; ++k) {
+            size_t s = k / (B * B * B), j = k % (B * B * B);
+            const float* e = g.edata + s * 3 * B * B * B + j;
+            if (!(VEIL_LUM_R * e[0] + VEIL_LUM_G * e[B * B * B] + VEIL_LUM_B * e[2 * B * B * B] > 0.0)) continue;
+            int local[3] = {(int)(j % B), (int)(j / B % B), (int)(j / (B * B))};
+            float* p = out->emitters + 6 * out->emitter_count++;
+            veil_grid_center(grid, B * g.coords[4 * s] + local[0], B * g.coords[4 * s + 1] + local[1],
+                             B * g.coords[4 * s + 2] + local[2], p);
+            for (int c = 0; c < 3; ++c) p[3 + c] = (float)(e[(size_t)c * B * B * B] * dv);
         }
     }
     out->count = g.count;
@@ -368,6 +471,8 @@ veil_result veil_sparse_build(const veil_scene_volume* v, int max_side, veil_spa
     free(g.keys);
     free(g.slots);
     free(g.data);
+    free(g.edata);
+    free(g.one);
     free(g.coords);
     if (r != VEIL_OK) veil_sparse_free(out);
     return r;

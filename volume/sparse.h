@@ -20,9 +20,12 @@
  *   empty node lets a ray skip 128 voxels at once, an empty brick 8.
  *
  * Values are the VDB grids' voxels copied (times each source's
- * density_scale, summed where grids overlap): a sparse volume needs every
- * VDB of the scene on one lattice (the same axis-aligned cubic voxel and
- * whole-voxel offsets), no particles and no emission grid; anything else
+ * density_scale, summed where grids overlap), and the emission of their
+ * emission and temperature grids per voxel as the dense path forms it, in
+ * an rgba atlas of the same layout (a brick is kept where it holds density
+ * or emission). A sparse volume needs every grid of the scene on one
+ * lattice (the same axis-aligned cubic voxel and whole-voxel offsets), no
+ * particles, and a temperature grid only with one vdb source; anything else
  * is dense (volume/scene_volume.h says which and why).
  */
 #ifndef VEIL_SPARSE_H
@@ -53,6 +56,9 @@ typedef struct veil_sparse {
     int atlas[3];         /* the atlas, in bricks */
     float* texels;        /* the atlas: 9 atlas[0] x 9 atlas[1] x 9 atlas[2] floats, x fastest */
     size_t voxels;        /* non-zero voxels copied */
+    float* emission_texels; /* with emission: 4 floats a texel of the atlas (eps rgb, 0), else NULL */
+    float* emitters;      /* the emitting voxels: 6 floats each, centre (m) and eps dV (W/sr) */
+    size_t emitter_count;
 } veil_sparse;
 
 /* Builds the sparse volume of v's VDB grids on v->grid (v->sparse set).

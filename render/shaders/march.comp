@@ -34,6 +34,10 @@
 // Emission (u.limits.y, in the variant compiled with VEIL_MARCH_EMISSION):
 // the EV's emission texture eps per step, integrated in closed form like
 // in-scattering, added to L (the medium's own light).
+// Over a sparse volume (VEIL_SPARSE, volume/sparse.h) the EV, the optical
+// depths, the escape field and the emission are atlases of the kept bricks
+// (volume/shaders/sparse_common.glsl), and the bricks and nodes not kept are
+// skipped (they hold neither density nor emission).
 // Output: rgb = L + L_v + T * background, a = 1 - mean(T). With u.limits.x
 // the march ends at the first step boundary at or beyond it (the same steps);
 // with u.flags.w each pixel's ray ends exactly at the distance in u_limit (a
@@ -196,7 +200,15 @@ void main()
         if (in_ev && u.limits.y != 0.0) {
             // emission eps constant over the step, attenuated within it as in-scattering is:
             // T eps dt (1 - exp(-x)) / x per channel (dt where the step has no density)
+#ifdef VEIL_SPARSE
+            vec3 q = (x - sp.origin.xyz) / sp.origin.w;
+            ivec3 eb = sp_brick(q);
+            int region;
+            uint slot = sp_slot(eb, region);
+            vec3 eps = slot == 0u ? vec3(0.0) : texture(u_emission, sp_atlas_uvw(slot, eb, q)).rgb;
+#else
             vec3 eps = texture(u_emission, (x - u.tex_min.xyz) * u.tex_inv_size.xyz).rgb;
+#endif
             vec3 opt = u.sigma_t.rgb * rho_dt;
             L += T * eps * dt * vec3(veil_step_integral(opt.r), veil_step_integral(opt.g), veil_step_integral(opt.b));
         }
