@@ -27,10 +27,11 @@ error: `veil compare --bin 4 --json`, rel_rmse_excess (relative RMSE of
   sparse by itself; time and memory only (no dense copy exists), beside
   sparse_crop.vdb dense.
 - pyro: data/generated/pyro_plume.vdb (`make data`), all orders:
-  multiple_scattering.emission_lights 0, 8 (the default) and 15.
+  multiple_scattering.emission_lights 0, 8 (the default) and 15; 8 sparse.
 
 References are cached in build/bench-cache/vdb/ keyed by the scene text,
-size, spp, flags and the veil binary's bytes. Results:
+size, spp, flags and the bytes of the veil binary that renders them
+(--ref-veil, default --veil). Results:
 docs/results/vdb_import.{csv,md}. Python 3 standard library only.
 """
 import argparse, hashlib, json, os, re, statistics, subprocess, sys, tempfile
@@ -107,7 +108,8 @@ def rows(a, tmp):
                             ("1.5x finer", {"max_resolution": (3 * max(dims)) // 2})):
             out.append(("rotated (dragon)", name, scene(*args, medium_extra=extra, ms=SINGLE), ref,
                         ["--max-order", "1"]))
-    pa, pb = os.path.join(tmp, "pair_a.vdb"), os.path.join(tmp, "pair_b.vdb")
+    # a stable place, so that the cached reference's key (the scene text) holds
+    pa, pb = (os.path.join(BUILD, "bench-cache", "vdb", n) for n in ("pair_a.vdb", "pair_b.vdb"))
     run([os.path.join(BUILD, "tests", "make_test_vdbs"), "--pair", pa, pb])
     cam = {"position": [0.2, 1.2, 4.5], "look_at": [0.1, 1.1, 0.0], "fov_y_deg": 40}
     lights = [{"type": "directional", "direction": [0.4, -0.8, -0.45], "irradiance": [3.0, 3.0, 3.0]},
@@ -138,6 +140,9 @@ def rows(a, tmp):
             s = json.loads(json.dumps(base))
             s["multiple_scattering"] = {"emission_lights": k}
             out.append(("pyro, all orders", "emission_lights %d%s" % (k, " (default)" if k == 8 else ""), s, base, []))
+        s = json.loads(json.dumps(base))
+        s["medium"]["representation"] = "sparse"
+        out.append(("pyro, all orders", "emission_lights 8, sparse", s, base, []))
     return out
 
 
@@ -148,6 +153,7 @@ def main():
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--rows", default="")
     ap.add_argument("--veil", default=os.path.join(BUILD, "veil"))
+    ap.add_argument("--ref-veil", default="", help="the veil that renders the references (default: --veil)")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "results"))
     a = ap.parse_args()
     w, h = (int(v) for v in a.size.split("x"))
@@ -156,7 +162,8 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     tmp = tempfile.mkdtemp(prefix="veil-vdb-")
     wanted = [r for r in a.rows.split(",") if r]
-    with open(a.veil, "rb") as fh:
+    ref_veil = a.ref_veil or a.veil
+    with open(ref_veil, "rb") as fh:
         binary = hashlib.sha1(fh.read()).hexdigest()
     results = []
     for row, variant, sc, ref, flags in rows(a, tmp):
@@ -182,7 +189,7 @@ def main():
                     f.write(text)
                 print("reference %s: %dx%d, %d spp %s ..." % (row, w, h, a.spp, " ".join(flags)), file=sys.stderr,
                       flush=True)
-                run([a.veil, "reference", rs, "-o", rp + ".part.exr", "--spp", str(a.spp), "--width", str(w),
+                run([ref_veil, "reference", rs, "-o", rp + ".part.exr", "--spp", str(a.spp), "--width", str(w),
                      "--height", str(h)] + flags)
                 os.replace(rp + ".part.exr", rp)
             c = json.loads(run([a.veil, "compare", img, rp, "--bin", "4", "--json"]))
