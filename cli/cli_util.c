@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 int veil_cli_usage_error(const char* fmt, const char* arg)
 {
@@ -70,3 +71,77 @@ veil_result veil_cli_check_output_folder(const char* path, veil_error* err)
     return VEIL_OK;
 }
 
+
+/* 1 when a and b name the same existing file, or the same path. */
+static int same_file(const char* a, const char* b)
+{
+    if (!strcmp(a, b)) return 1;
+    struct stat sa, sb;
+    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+int veil_cli_check_outputs(const char* const* inputs, int n_in, const char* const* outputs, const char* const* names,
+                           int n_out)
+{
+    for (int i = 0; i < n_out; ++i) {
+        if (!outputs[i]) continue;
+        char what[160];
+        if (!outputs[i][0]) {
+            snprintf(what, sizeof what, "%s: an empty path", names[i]);
+            return veil_cli_usage_error("%s", what);
+        }
+        struct stat st;
+        if (stat(outputs[i], &st) == 0 && S_ISDIR(st.st_mode)) {
+            snprintf(what, sizeof what, "%s: '%%s' is a directory", names[i]);
+            return veil_cli_usage_error(what, outputs[i]);
+        }
+        for (int j = 0; j < n_in; ++j)
+            if (inputs[j] && same_file(outputs[i], inputs[j])) {
+                snprintf(what, sizeof what, "%s: '%%s' is an input of this run (it would be overwritten)", names[i]);
+                return veil_cli_usage_error(what, outputs[i]);
+            }
+        for (int j = 0; j < i; ++j)
+            if (outputs[j] && same_file(outputs[i], outputs[j])) {
+                snprintf(what, sizeof what, "%s and %s: both are '%%s'", names[j], names[i]);
+                return veil_cli_usage_error(what, outputs[i]);
+            }
+    }
+    return EXIT_OK;
+}
+
+const char* veil_cli_stage(veil_cli_outputs* o, const char* target, veil_error* err)
+{
+    if (o->count == 4) {
+        veil_fail(err, VEIL_ERR_INVALID, "at most 4 outputs");
+        return NULL;
+    }
+    struct stat st;
+    if (stat(target, &st) == 0 && !S_ISREG(st.st_mode)) {
+        /* renaming over it would replace it (a FIFO, a device): as the writers refuse it */
+        veil_fail(err, VEIL_ERR_IO, "%s: exists and is not a regular file", target);
+        return NULL;
+    }
+    int i = o->count;
+    int n = snprintf(o->staged[i], sizeof o->staged[i], "%s.veil-staged%ld", target, (long)getpid());
+    if (n < 0 || (size_t)n >= sizeof o->staged[i]) {
+        veil_fail(err, VEIL_ERR_IO, "%s: path too long", target);
+        return NULL;
+    }
+    o->target[i] = target;
+    o->count++;
+    return o->staged[i];
+}
+
+veil_result veil_cli_commit(veil_cli_outputs* o, int ok, veil_error* err)
+{
+    veil_result r = VEIL_OK;
+    for (int i = 0; i < o->count; ++i) {
+        if (ok && r == VEIL_OK && rename(o->staged[i], o->target[i]) != 0)
+            r = veil_fail(err, VEIL_ERR_IO, "%s: cannot rename the finished file over it: %s", o->target[i],
+                          strerror(errno));
+        else if (!ok || r != VEIL_OK)
+            unlink(o->staged[i]);
+    }
+    o->count = 0;
+    return r;
+}

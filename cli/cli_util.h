@@ -21,4 +21,32 @@ int veil_cli_parse_float(const char* s, float lo, float hi, float* out);
  * not exist (checked before any work, so nothing is written half). */
 veil_result veil_cli_check_output_folder(const char* path, veil_error* err);
 
+/* Usage checks of the output paths before any work (exit 2, naming the
+ * option): none empty, no two the same file (the same path, or an existing
+ * file under two names), none an input file (a scene, a frame: the run
+ * would overwrite what it reads), none an existing directory. inputs and
+ * outputs: n strings each, NULL entries skipped; names: each output's
+ * option ("-o", "--png"). Returns EXIT_OK or EXIT_USAGE (message printed). */
+int veil_cli_check_outputs(const char* const* inputs, int n_in, const char* const* outputs, const char* const* names,
+                           int n_out);
+
+/* All or nothing for a command that writes several files: each writer
+ * writes a staging file beside its target ("<target>.veil-staged<pid>"),
+ * and only when all are written are they renamed over the targets; on a
+ * failure the staged files are removed and every existing target is left
+ * as it was. */
+typedef struct veil_cli_outputs {
+    const char* target[4];
+    char staged[4][4200];
+    int count;
+} veil_cli_outputs;
+/* The staging path to write target to (its name kept in `o`); NULL and
+ * VEIL_ERR_IO when the target exists and is not a regular file. Stage each
+ * file just before writing it. */
+const char* veil_cli_stage(veil_cli_outputs* o, const char* target, veil_error* err);
+/* Renames every staged file over its target (VEIL_ERR_IO naming it when one
+ * cannot be, after which the rest are removed), or, with ok == 0, removes
+ * them. */
+veil_result veil_cli_commit(veil_cli_outputs* o, int ok, veil_error* err);
+
 #endif

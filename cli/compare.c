@@ -205,6 +205,11 @@ int veil_cmd_compare(int argc, char** argv)
     compare_args a;
     int rc = parse_args(argc, argv, &a);
     if (rc >= 0) return rc;
+    const char* ins[2] = {a.image, a.reference};
+    const char* outs[1] = {a.heatmap};
+    const char* opts[1] = {"--heatmap"};
+    rc = veil_cli_check_outputs(ins, 2, outs, opts, 1);
+    if (rc != EXIT_OK) return rc;
 
     veil_error err = {0};
     int wa = 0, ha = 0, wb = 0, hb = 0;

@@ -126,6 +126,11 @@ int veil_cmd_fog(int argc, char** argv)
     float *frame = NULL, *depth = NULL;
     int w = 0, h = 0;
     const char* channel = NULL;
+    const char* ins[2] = {a.frame, a.scene};
+    const char* outs[2] = {a.exr, a.png};
+    const char* names[2] = {"-o", "--png"};
+    rc = veil_cli_check_outputs(ins, 2, outs, names, 2);
+    if (rc != EXIT_OK) return rc;
     veil_result r = veil_cli_check_output_folder(a.exr, &err);
     if (r == VEIL_OK && a.png) r = veil_cli_check_output_folder(a.png, &err);
     if (r == VEIL_OK) r = veil_scene_load(a.scene, &scene, &err);
@@ -151,11 +156,14 @@ int veil_cmd_fog(int argc, char** argv)
         r = veil_render_scene_images(ren, &scene, &opts, &im, &st, &err);
         if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
     }
-    if (r == VEIL_OK) r = veil_image_set_write_exr(&im, a.exr, a.aovs, &err);
-    if (r == VEIL_OK && a.png) {
-        r = veil_write_png(a.png, im.width, im.height, im.rgba, 0.0f, &err);
-        if (r != VEIL_OK) unlink(a.exr); /* all or nothing */
-    }
+    /* all or nothing: both staged, then renamed over the targets (cli/cli_util.h) */
+    veil_cli_outputs out = {0};
+    const char* stage = r == VEIL_OK ? veil_cli_stage(&out, a.exr, &err) : NULL;
+    if (r == VEIL_OK) r = stage ? veil_image_set_write_exr(&im, stage, a.aovs, &err) : VEIL_ERR_IO;
+    stage = r == VEIL_OK && a.png ? veil_cli_stage(&out, a.png, &err) : NULL;
+    if (r == VEIL_OK && a.png) r = stage ? veil_write_png(stage, im.width, im.height, im.rgba, 0.0f, &err) : VEIL_ERR_IO;
+    veil_result committed = veil_cli_commit(&out, r == VEIL_OK, &err);
+    if (r == VEIL_OK) r = committed;
     if (r == VEIL_OK && a.stats)
         for (int i = 0; i < VEIL_STAGE_COUNT; ++i)
             printf("%-10s %9.2f ms  (%s: %s)\n", veil_stage_name((veil_stage_id)i), st.stage[i].ms,

@@ -130,6 +130,11 @@ int veil_cmd_reference(int argc, char** argv)
     if (code >= 0) return code;
     veil_error err = {0};
     veil_scene scene;
+    const char* ins[1] = {a.scene};
+    const char* outs[1] = {a.exr};
+    const char* opts[1] = {"-o"};
+    code = veil_cli_check_outputs(ins, 1, outs, opts, 1);
+    if (code != EXIT_OK) return code;
     veil_result r = veil_cli_check_output_folder(a.exr, &err);
     if (r != VEIL_OK) return veil_cli_fail(r, &err);
     r = veil_scene_load(a.scene, &scene, &err);

@@ -100,6 +100,11 @@ int veil_cmd_render(int argc, char** argv)
     double t_start = veil_now_ms();
     veil_error err = {0};
     veil_scene scene;
+    const char* ins[1] = {a.scene};
+    const char* outs[2] = {a.exr, a.png};
+    const char* names[2] = {"-o", "--png"};
+    rc = veil_cli_check_outputs(ins, 1, outs, names, 2);
+    if (rc != EXIT_OK) return rc;
     veil_result r = veil_cli_check_output_folder(a.exr, &err);
     if (r == VEIL_OK && a.png) r = veil_cli_check_output_folder(a.png, &err);
     if (r != VEIL_OK) return veil_cli_fail(r, &err);
@@ -123,11 +128,15 @@ int veil_cmd_render(int argc, char** argv)
         if (r == VEIL_OK) r = veil_frame_path(a.exr, f, a.frames > 0, exr, sizeof exr, &err);
         if (r == VEIL_OK && a.png) r = veil_frame_path(a.png, f, a.frames > 0, png, sizeof png, &err);
         double t_write = veil_now_ms();
-        if (r == VEIL_OK) r = veil_image_set_write_exr(&im, exr, a.aovs, &err);
-        if (r == VEIL_OK && a.png) {
-            r = veil_write_png(png, im.width, im.height, im.rgba, 0.0f, &err);
-            if (r != VEIL_OK) unlink(exr); /* all or nothing, per frame */
-        }
+        /* all or nothing, per frame: both files staged, then renamed over the targets (an existing
+         * OUT.exr stays as it was when the PNG cannot be written) */
+        veil_cli_outputs out = {0};
+        const char* stage = r == VEIL_OK ? veil_cli_stage(&out, exr, &err) : NULL;
+        if (r == VEIL_OK) r = stage ? veil_image_set_write_exr(&im, stage, a.aovs, &err) : VEIL_ERR_IO;
+        stage = r == VEIL_OK && a.png ? veil_cli_stage(&out, png, &err) : NULL;
+        if (r == VEIL_OK && a.png) r = stage ? veil_write_png(stage, im.width, im.height, im.rgba, 0.0f, &err) : VEIL_ERR_IO;
+        veil_result c = veil_cli_commit(&out, r == VEIL_OK, &err);
+        if (r == VEIL_OK) r = c;
         if (r != VEIL_OK) break;
         if (a.stats) {
             if (frames > 1) printf("frame %ld\n", f);

@@ -12,6 +12,12 @@ add_test(NAME cli_end_to_end
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli_end_to_end.sh $<TARGET_FILE:veil_cli>
           ${PROJECT_SOURCE_DIR}/data/scenes/demo.json $<TARGET_FILE:exr_stats>)
 set_tests_properties(cli_end_to_end PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)
+# Output paths (issue 12): never the input, never two outputs in one file, never
+# an existing output lost when the PNG fails after the EXR (tests/output_paths.sh).
+add_test(NAME cli_output_paths
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/output_paths.sh $<TARGET_FILE:veil_cli>
+          ${PROJECT_SOURCE_DIR}/data/scenes/height_fog.json)
+set_tests_properties(cli_output_paths PROPERTIES LABELS "gpu;cli;bad_input" SKIP_RETURN_CODE 77)
 veil_test(test_render_cache SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_render_cache.c LABELS gpu)
 # The marcher against closed forms (airlight, a Gaussian's erf, slanted
 # exponential fog) within step-error bounds derived in the test.
