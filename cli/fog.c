@@ -104,9 +104,11 @@ static veil_result to_distance(const fog_args* a, const veil_camera* cam, int w,
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             float* d = &depth[(size_t)y * (size_t)w + (size_t)x];
+            char got[32];
             if (isnan(*d) || *d < 0.0f)
-                return veil_fail(err, VEIL_ERR_INVALID, "%s: channel %s at pixel (%d, %d) is %g: expected a depth "
-                                 ">= 0 (m; inf where nothing was hit)", a->frame, channel, x, y, *d);
+                return veil_fail(err, VEIL_ERR_INVALID, "%s: channel %s at pixel (%d, %d) is %s: expected a depth "
+                                 ">= 0 (m; inf where nothing was hit)", a->frame, channel, x, y,
+                                 veil_number_text(*d, got, sizeof got));
             if (a->depth_is_distance) continue;
             float dir[3];
             veil_camera_ray(&b, w, h, x, y, dir);
@@ -140,9 +142,12 @@ int veil_cmd_fog(int argc, char** argv)
                       "camera.height): the frame must be rendered with the scene's camera", a.frame, w, h, a.scene,
                       scene.camera.width, scene.camera.height);
     for (size_t i = 0; r == VEIL_OK && i < (size_t)w * (size_t)h * 4; ++i)
-        if (i % 4 != 3 && !isfinite(frame[i]))
-            r = veil_fail(&err, VEIL_ERR_INVALID, "%s: pixel (%zu, %zu) channel %c is %g: expected finite radiance",
-                          a.frame, (i / 4) % (size_t)w, (i / 4) / (size_t)w, "RGB"[i % 4], frame[i]);
+        if (i % 4 != 3 && !isfinite(frame[i])) {
+            char got[32];
+            r = veil_fail(&err, VEIL_ERR_INVALID, "%s: pixel (%zu, %zu) channel %c is %s: expected finite radiance",
+                          a.frame, (i / 4) % (size_t)w, (i / 4) / (size_t)w, "RGB"[i % 4],
+                          veil_number_text(frame[i], got, sizeof got));
+        }
     if (r == VEIL_OK) r = read_depth(&a, w, h, &depth, &channel, &err);
     if (r == VEIL_OK) r = to_distance(&a, &scene.camera, w, h, channel, depth, &err);
     veil_gl* gl = NULL;

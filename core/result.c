@@ -1,5 +1,7 @@
 #include "result.h"
 
+#include <math.h>
+
 #include <stdarg.h>
 #include <stdio.h>
 
@@ -44,4 +46,12 @@ int veil_mul_sizes(size_t a, size_t b, size_t c, size_t d, size_t* out)
     }
     *out = n;
     return 1;
+}
+
+const char* veil_number_text(double x, char* buf, size_t n)
+{
+    if (isnan(x)) snprintf(buf, n, "not a number");
+    else if (isinf(x)) snprintf(buf, n, "%sinfinity", x < 0 ? "-" : "");
+    else snprintf(buf, n, "%g", x);
+    return buf;
 }

@@ -21,6 +21,10 @@ veil_result veil_fail(veil_error* err, veil_result code, const char* fmt, ...)
 #endif
     ;
 
+/* x as a message shows it: "%g", or "not a number", "infinity",
+ * "-infinity" (never "nan" or "inf"). Returns buf (n >= 32). */
+const char* veil_number_text(double x, char* buf, size_t n);
+
 /* True when n = a*b*c*d fits in size_t; writes the product to *out. */
 int veil_mul_sizes(size_t a, size_t b, size_t c, size_t d, size_t* out);
 

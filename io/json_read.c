@@ -10,8 +10,14 @@
 #include <string.h>
 
 #include "scene.h"
+#include "../scene/limits.h"
 
 const range VEIL__R_ANY = {-DBL_MAX, DBL_MAX, false, false, false, "a number"};
+const range VEIL__R_COORD = {-VEIL_MAX_COORD, VEIL_MAX_COORD, false, false, false,
+                             "a number in [-1e15, 1e15] (m: scene/limits.h)"};
+const range VEIL__R_LIGHT = {0, VEIL_MAX_LIGHT, false, false, false, "a number in [0, 1e20] (scene/limits.h)"};
+const range VEIL__R_SHARPNESS = {VEIL_MIN_SHARPNESS, DBL_MAX, false, false, false,
+                                 "a number >= 1e-29 (its cut-off radius within 1e15 m: scene/limits.h)"};
 const range VEIL__R_NONNEG = {0, DBL_MAX, false, false, false, "a number >= 0"};
 const range VEIL__R_POS = {0, DBL_MAX, true, false, false, "a number > 0"};
 const range VEIL__R_FOV = {0, 180, true, true, false, "a number of degrees in (0, 180)"};
@@ -179,18 +185,43 @@ veil_result veil__jr_get_int(const ctx* c, const cJSON* obj, const jpath* pp, co
 /* An array of exactly n numbers (>= 0 when nonneg). */
 veil_result veil__jr_parse_floats(const ctx* c, const cJSON* v, const jpath* p, int n, bool nonneg, float* out)
 {
-    char what[64];
-    snprintf(what, sizeof what, "an array of %d numbers%s", n, nonneg ? " >= 0" : "");
+    return veil__jr_parse_floats_in(c, v, p, n, nonneg ? &VEIL__R_NONNEG : &VEIL__R_ANY, out);
+}
+
+/* "an array of 3 numbers >= 0", "... numbers, each in [0, 1e20] (...)". */
+static void float_array_what(int n, const range* r, char* what, size_t len)
+{
+    if (r == &VEIL__R_ANY || r == &VEIL__R_NONNEG)
+        snprintf(what, len, "an array of %d numbers%s", n, r == &VEIL__R_NONNEG ? " >= 0" : "");
+    else
+        snprintf(what, len, "an array of %d numbers, each %s", n, r->what + (strncmp(r->what, "a number ", 9) ? 0 : 9));
+}
+
+veil_result veil__jr_parse_floats_in(const ctx* c, const cJSON* v, const jpath* p, int n, const range* r, float* out)
+{
+    char what[160];
+    float_array_what(n, r, what, sizeof what);
     if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != n) return veil__jr_expected(c, p, what, v);
     size_t i = 0;
     const cJSON* e;
     cJSON_ArrayForEach(e, v) {
         const jpath ep = {p, NULL, i};
         double x;
-        TRY(veil__jr_parse_number(c, e, &ep, nonneg ? &VEIL__R_NONNEG : &VEIL__R_ANY, &x));
+        TRY(veil__jr_parse_number(c, e, &ep, r, &x));
         out[i++] = (float)x;
     }
     return VEIL_OK;
+}
+
+veil_result veil__jr_get_floats_in(const ctx* c, const cJSON* obj, const jpath* pp, const char* key, bool required,
+                                   int n, const range* r, float* out)
+{
+    const jpath p = {pp, key, 0};
+    const cJSON* v;
+    char what[160];
+    float_array_what(n, r, what, sizeof what);
+    TRY(veil__jr_lookup(c, obj, &p, required, what, &v));
+    return v ? veil__jr_parse_floats_in(c, v, &p, n, r, out) : VEIL_OK;
 }
 
 veil_result veil__jr_get_floats(const ctx* c, const cJSON* obj, const jpath* pp, const char* key,

@@ -42,6 +42,9 @@ typedef struct range {
 
 /* The accepted ranges, shared by the scene readers. */
 extern const range VEIL__R_ANY;
+extern const range VEIL__R_COORD;     /* positions: scene/limits.h */
+extern const range VEIL__R_LIGHT;     /* intensities, irradiances: scene/limits.h */
+extern const range VEIL__R_SHARPNESS; /* particle sharpness: scene/limits.h */
 extern const range VEIL__R_NONNEG;
 extern const range VEIL__R_POS;
 extern const range VEIL__R_FOV;
@@ -76,6 +79,10 @@ veil_result veil__jr_get_number(const ctx* c, const cJSON* obj, const jpath* pp,
 veil_result veil__jr_get_int(const ctx* c, const cJSON* obj, const jpath* pp, const char* key, const range* r, int* out);
 veil_result veil__jr_parse_floats(const ctx* c, const cJSON* v, const jpath* p, int n, bool nonneg, float* out);
 veil_result veil__jr_get_floats(const ctx* c, const cJSON* obj, const jpath* pp, const char* key, bool required, int n, bool nonneg, float* out);
+/* The same with every element in range r (positions: &VEIL__R_COORD). */
+veil_result veil__jr_get_floats_in(const ctx* c, const cJSON* obj, const jpath* pp, const char* key, bool required,
+                                   int n, const range* r, float* out);
+veil_result veil__jr_parse_floats_in(const ctx* c, const cJSON* v, const jpath* p, int n, const range* r, float* out);
 veil_result veil__jr_get_kind(const ctx* c, const cJSON* obj, const jpath* pp, const char* const* names, int* kind);
 veil_result veil__jr_alloc_items(const ctx* c, const jpath* p, const cJSON* arr, size_t size, size_t limit, void** items, size_t* count);
 

@@ -13,6 +13,7 @@
 
 #include "json_read.h"
 #include "particles_json.h"
+#include "../scene/limits.h"
 #include "scene.h"
 #include "tempfile.h"
 
@@ -27,12 +28,14 @@ static const char* const FIELD_NAMES[5] = {"center[0]", "center[1]", "center[2]"
 /* ---- checks shared by reader and writer -------------------------------- */
 
 /* Index of the first bad field of q (0..4), or -1; *why says what was expected. */
+/* The field a particle breaks (scene/limits.h), or -1. */
 static int bad_field(const veil_particle* q, const char** why)
 {
     for (int k = 0; k < 3; ++k)
-        if (!isfinite(q->center[k])) return *why = "a finite number", k;
+        if (!(fabsf(q->center[k]) <= (float)VEIL_MAX_COORD)) return *why = "a number in [-1e15, 1e15] (m: scene/limits.h)", k;
     if (!(isfinite(q->amplitude) && q->amplitude >= 0.0f)) return *why = "a finite number >= 0", 3;
-    if (!(isfinite(q->sharpness) && q->sharpness > 0.0f)) return *why = "a finite number > 0", 4;
+    if (!(isfinite(q->sharpness) && q->sharpness >= (float)VEIL_MIN_SHARPNESS))
+        return *why = "a finite number >= 1e-29 (scene/limits.h)", 4;
     return -1;
 }
 
@@ -103,8 +106,9 @@ static veil_result read_binary(const char* path, const unsigned char* b, size_t 
         const char* why;
         int k = bad_field(q, &why);
         if (k >= 0) {
-            veil_result res = veil_fail(err, VEIL_ERR_INVALID, "%s: particle %u: %s: expected %s, got %g", path, i,
-                                        FIELD_NAMES[k], why, (double)field(q, k));
+            char got[32];
+            veil_result res = veil_fail(err, VEIL_ERR_INVALID, "%s: particle %u: %s: expected %s, got %s", path, i,
+                                        FIELD_NAMES[k], why, veil_number_text(field(q, k), got, sizeof got));
             free(p);
             return res;
         }
@@ -128,9 +132,9 @@ veil_result veil__parse_particle_array(const ctx* c, const cJSON* obj, const jpa
         double amp, sharp;
         if (!cJSON_IsObject(e)) return veil__jr_expected(c, &ep, "an object", e);
         TRY(veil__jr_check_keys(c, e, &ep, PARTICLE_KEYS));
-        TRY(veil__jr_get_floats(c, e, &ep, "center", true, 3, false, q->center));
+        TRY(veil__jr_get_floats_in(c, e, &ep, "center", true, 3, &VEIL__R_COORD, q->center));
         TRY(veil__jr_get_number(c, e, &ep, "amplitude", true, &VEIL__R_NONNEG, &amp));
-        TRY(veil__jr_get_number(c, e, &ep, "sharpness", true, &VEIL__R_POS, &sharp));
+        TRY(veil__jr_get_number(c, e, &ep, "sharpness", true, &VEIL__R_SHARPNESS, &sharp));
         q->amplitude = (float)amp, q->sharpness = (float)sharp;
     }
     return VEIL_OK;
@@ -239,21 +243,44 @@ static void fmt_float(char* out, size_t n, float f)
     if (!(fabs(d) <= FLT_MAX) || (float)d != f) snprintf(out, n, "%.17g", (double)f);
 }
 
+/* Each particle's line is written whole into `line` (at most 16 + 5 x 24
+ * digits of fmt_float + 36 of text: 172 bytes), then appended, the buffer
+ * growing when it must: no line is ever cut, none written past the end. */
 static veil_result encode_json(const veil_particle* p, size_t n, char** buf, size_t* len)
 {
     static const char head[] = "{\"format\": \"veil-particles\", \"version\": 1, \"particles\": [";
-    enum { PER = 160 };
+    enum { PER = 176 };
     size_t cap = sizeof head + 8 + n * PER;
     char* b = malloc(cap);
     if (!b) return VEIL_ERR_OOM;
-    size_t k = (size_t)snprintf(b, cap, "%s", head);
-    for (size_t i = 0; i < n; ++i) {
-        char v[5][32];
-        for (int f = 0; f < 5; ++f) fmt_float(v[f], sizeof v[f], field(&p[i], f));
-        k += (size_t)snprintf(b + k, cap - k, "%s\n  {\"center\": [%s, %s, %s], \"amplitude\": %s, \"sharpness\": %s}",
-                              i ? "," : "", v[0], v[1], v[2], v[3], v[4]);
+    size_t k = sizeof head - 1;
+    memcpy(b, head, k);
+    for (size_t i = 0; i <= n; ++i) {
+        char v[5][32], line[256];
+        int m;
+        if (i < n) {
+            for (int f = 0; f < 5; ++f) fmt_float(v[f], sizeof v[f], field(&p[i], f));
+            m = snprintf(line, sizeof line, "%s\n  {\"center\": [%s, %s, %s], \"amplitude\": %s, \"sharpness\": %s}",
+                         i ? "," : "", v[0], v[1], v[2], v[3], v[4]);
+        } else {
+            m = snprintf(line, sizeof line, "%s]}\n", n ? "\n" : "");
+        }
+        if (m < 0 || (size_t)m >= sizeof line) {
+            free(b);
+            return VEIL_ERR_INVALID;
+        }
+        if (k + (size_t)m + 1 > cap) {
+            size_t grown = 2 * cap + (size_t)m + 1;
+            char* nb = realloc(b, grown);
+            if (!nb) {
+                free(b);
+                return VEIL_ERR_OOM;
+            }
+            b = nb, cap = grown;
+        }
+        memcpy(b + k, line, (size_t)m + 1);
+        k += (size_t)m;
     }
-    k += (size_t)snprintf(b + k, cap - k, "%s]}\n", n ? "\n" : "");
     *buf = b, *len = k;
     return VEIL_OK;
 }
@@ -268,8 +295,11 @@ veil_result veil_particles_write(const char* path, const veil_particle* p, size_
         const char* why;
         int k = bad_field(&p[i], &why);
         if (k >= 0)
-            return veil_fail(err, VEIL_ERR_INVALID, "%s: particle %zu: %s: expected %s, got %g", path, i,
-                             FIELD_NAMES[k], why, (double)field(&p[i], k));
+        {
+            char got[32];
+            return veil_fail(err, VEIL_ERR_INVALID, "%s: particle %zu: %s: expected %s, got %s", path, i,
+                             FIELD_NAMES[k], why, veil_number_text(field(&p[i], k), got, sizeof got));
+        }
     }
     char* buf = NULL;
     size_t len = 0;

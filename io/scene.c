@@ -60,8 +60,8 @@ static veil_result parse_camera(const ctx* c, const cJSON* root, veil_camera* ca
     double fov = cam->fov_y_deg;
     TRY(veil__jr_get_container(c, root, &p, true, false, &o));
     TRY(veil__jr_check_keys(c, o, &p, CAMERA_KEYS));
-    TRY(veil__jr_get_floats(c, o, &p, "position", true, 3, false, cam->position));
-    TRY(veil__jr_get_floats(c, o, &p, "look_at", true, 3, false, cam->look_at));
+    TRY(veil__jr_get_floats_in(c, o, &p, "position", true, 3, &VEIL__R_COORD, cam->position));
+    TRY(veil__jr_get_floats_in(c, o, &p, "look_at", true, 3, &VEIL__R_COORD, cam->look_at));
     TRY(veil__jr_get_floats(c, o, &p, "up", false, 3, false, cam->up));
     TRY(veil__jr_get_number(c, o, &p, "fov_y_deg", false, &VEIL__R_FOV, &fov));
     cam->fov_y_deg = (float)fov;
@@ -146,10 +146,11 @@ static veil_result parse_lights(const ctx* c, const cJSON* root, veil_scene* s)
         TRY(veil__jr_get_kind(c, e, &ep, LIGHT_TYPES, &kind));
         l->type = (veil_light_type)kind;
         TRY(veil__jr_check_keys(c, e, &ep, LIGHT_KEYS[kind]));
-        if (kind != VEIL_LIGHT_DIRECTIONAL) TRY(veil__jr_get_floats(c, e, &ep, "position", true, 3, false, l->position));
+        if (kind != VEIL_LIGHT_DIRECTIONAL)
+            TRY(veil__jr_get_floats_in(c, e, &ep, "position", true, 3, &VEIL__R_COORD, l->position));
         if (kind != VEIL_LIGHT_POINT) TRY(parse_direction(c, e, &ep, l->direction));
         const char* power = kind == VEIL_LIGHT_DIRECTIONAL ? "irradiance" : "intensity";
-        TRY(veil__jr_get_floats(c, e, &ep, power, true, 3, true, l->color));
+        TRY(veil__jr_get_floats_in(c, e, &ep, power, true, 3, &VEIL__R_LIGHT, l->color));
         if (kind == VEIL_LIGHT_SPOT) TRY(parse_cone(c, e, &ep, l));
     }
     return VEIL_OK;

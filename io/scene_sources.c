@@ -3,6 +3,7 @@
  * clouds, OpenVDB grids and analytic exponential fog. Private to io/. */
 #include "scene_sources.h"
 #include "particles.h"
+#include "../scene/limits.h"
 #include "particles_json.h"
 
 #include <errno.h>
@@ -34,8 +35,8 @@ static veil_result parse_bounds(const ctx* c, const cJSON* so, const jpath* sp, 
     const cJSON* v;
     TRY(veil__jr_lookup(c, so, &p, true, what, &v));
     if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 2) return veil__jr_expected(c, &p, what, v);
-    TRY(veil__jr_parse_floats(c, cJSON_GetArrayItem(v, 0), &ep[0], 3, false, b[0]));
-    TRY(veil__jr_parse_floats(c, cJSON_GetArrayItem(v, 1), &ep[1], 3, false, b[1]));
+    TRY(veil__jr_parse_floats_in(c, cJSON_GetArrayItem(v, 0), &ep[0], 3, &VEIL__R_COORD, b[0]));
+    TRY(veil__jr_parse_floats_in(c, cJSON_GetArrayItem(v, 1), &ep[1], 3, &VEIL__R_COORD, b[1]));
     for (int i = 0; i < 3; ++i)
         if (b[0][i] > b[1][i])
             return veil__jr_fail_at(c, &p, "expected min <= max on every axis, got %c: %g > %g",
@@ -51,7 +52,8 @@ static veil_result parse_random(const ctx* c, const cJSON* so, const jpath* sp, 
     TRY(veil__jr_get_number(c, so, sp, "seed", true, &VEIL__R_SEED, &seed));
     d->count = (uint32_t)count, d->seed = (uint64_t)seed;
     TRY(parse_bounds(c, so, sp, d->bounds));
-    TRY(veil__jr_get_floats(c, so, sp, "radius", true, 2, true, d->radius));
+    static const range radius = {0, VEIL_MAX_COORD, false, false, false, "a number in [0, 1e15] (m: scene/limits.h)"};
+    TRY(veil__jr_get_floats_in(c, so, sp, "radius", true, 2, &radius, d->radius));
     if (!(d->radius[0] > 0 && d->radius[0] <= d->radius[1] && isfinite(1.0f / d->radius[0])))
         return veil__jr_fail_at(c, &rp, "expected [r0, r1] with 0 < r0 <= r1 (metres), got [%g, %g]",
                        d->radius[0], d->radius[1]);
@@ -185,7 +187,7 @@ static veil_result parse_fog(const ctx* c, const cJSON* so, const jpath* sp, vei
     if (!(len > 0))
         return veil__jr_fail_at(c, &dp, "expected a non-zero vector (the direction the density falls off along)");
     for (int a = 0; a < 3; ++a) f->direction[a] = (float)(f->direction[a] / len);
-    TRY(veil__jr_get_floats(c, so, sp, "origin", true, 3, false, f->origin));
+    TRY(veil__jr_get_floats_in(c, so, sp, "origin", true, 3, &VEIL__R_COORD, f->origin));
     if (cJSON_GetObjectItemCaseSensitive(so, "bounds")) {
         TRY(parse_bounds(c, so, sp, f->bounds));
     } else {

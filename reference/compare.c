@@ -20,9 +20,11 @@ static veil_result check_finite(const float* a, const float* b, int width, int h
                 const float* px = (which ? b : a) + p;
                 for (int c = 0; c < 4; ++c) {
                     if (isfinite(px[c])) continue;
+                    char got[32];
                     return veil_fail(err, VEIL_ERR_INVALID,
-                                     "%s has a non-finite value (%g) at pixel (%d, %d) channel %s",
-                                     which ? "reference" : "image", (double)px[c], x, y, channel_names[c]);
+                                     "%s has a non-finite value (%s) at pixel (%d, %d) channel %s",
+                                     which ? "reference" : "image", veil_number_text(px[c], got, sizeof got), x, y,
+                                     channel_names[c]);
                 }
             }
         }

@@ -32,7 +32,7 @@ check 0 "channel depth.Z" "$dir/depthz.exr" --scene "$dir/fog_scene.json" -o "$d
 check 0 "as distance along the ray" "$dir/sky.exr" --scene "$dir/fog_scene.json" -o "$dir/out3.exr" --depth-is distance
 echo keep > "$dir/keep.exr"
 check 1 "no depth channel" "$dir/noz.exr" --scene "$dir/fog_scene.json" -o "$dir/keep.exr"
-check 1 "pixel (7, 3) is nan" "$dir/nanz.exr" --scene "$dir/fog_scene.json" -o "$dir/keep.exr"
+check 1 "pixel (7, 3) is not a number" "$dir/nanz.exr" --scene "$dir/fog_scene.json" -o "$dir/keep.exr"
 check 1 "pixel (0, 0) is -1" "$dir/negz.exr" --scene "$dir/fog_scene.json" -o "$dir/keep.exr"
 check 1 "camera.width" "$dir/small.exr" --scene "$dir/fog_scene.json" -o "$dir/keep.exr"
 check 1 "no channel 'Q'" "$dir/good.exr" --scene "$dir/fog_scene.json" -o "$dir/keep.exr" --depth-channel Q

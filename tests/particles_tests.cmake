@@ -24,7 +24,7 @@ veil_bad_input(particles_missing_file ${PDATA}/particles_missing_file.json
 veil_bad_input(particles_corrupt_file ${PDATA}/particles_corrupt_file.json
                "particles_corrupt_file.json: medium.sources[0].file: ${PDATA}/corrupt_cloud.bin: truncated header")
 veil_bad_input(particles_bad_sharpness ${PDATA}/particles_bad_sharpness.json
-               "medium.sources[0].file: ${PDATA}/bad_cloud.json: particles[1].sharpness: expected a number > 0, got -4")
+               "medium.sources[0].file: ${PDATA}/bad_cloud.json: particles[1].sharpness: expected a number >= 1e-29 (its cut-off radius within 1e15 m: scene/limits.h), got -4")
 
 # The CLI tests: one bash script, one mode per test (VEIL MODE).
 file(WRITE ${PDATA}/rbf_cli.sh [=[#!/usr/bin/env bash

@@ -17,18 +17,18 @@ veil_bad_input(trailing_content ${BAD}/trailing_content.json
 veil_bad_input(empty ${BAD}/empty.json "empty.json:1:1: JSON syntax error: unexpected end of input")
 veil_bad_input(not_an_object ${BAD}/not_an_object.json "expected a JSON object at the top level")
 veil_bad_input(wrong_type ${BAD}/wrong_type.json
-               "lights[1].intensity: expected an array of 3 numbers >= 0, got a string")
+               "lights[1].intensity: expected an array of 3 numbers, each in [0, 1e20] (scene/limits.h), got a string")
 veil_bad_input(unknown_key ${BAD}/unknown_key.json
                "camera.fov: unknown key (expected one of: position, look_at, up, fov_y_deg, width, height)")
 veil_bad_input(missing_field ${BAD}/missing_field.json
-               "camera.position: missing required field (an array of 3 numbers)")
+               "camera.position: missing required field (an array of 3 numbers, each in [-1e15, 1e15] (m: scene/limits.h))")
 veil_bad_input(negative_resolution ${BAD}/negative_resolution.json
                "medium.max_resolution: expected an integer in [2, 2048], got -16 (negative and zero values are not allowed)")
 veil_bad_input(bad_phase_type ${BAD}/bad_phase_type.json "medium.phase.type: expected one of")
 veil_bad_input(g_out_of_range ${BAD}/g_out_of_range.json "medium.phase.g: expected a number in (-1, 1), got 1.5")
 veil_bad_input(zero_direction ${BAD}/zero_direction.json "lights[0].direction: expected a non-zero vector")
 veil_bad_input(bad_sharpness ${BAD}/bad_sharpness.json
-               "medium.sources[0].particles[1].sharpness: expected a number > 0, got 0")
+               "medium.sources[0].particles[1].sharpness: expected a number >= 1e-29 (its cut-off radius within 1e15 m: scene/limits.h), got 0")
 veil_bad_input(bad_seed ${BAD}/bad_seed.json "medium.sources[0].seed: expected an integer in [0, 2^53), got 1.5")
 veil_bad_input(camera_on_target ${BAD}/camera_on_target.json "camera.look_at: must differ from camera.position")
 veil_bad_input(too_many_lights ${BAD}/too_many_lights.json "too_many_lights.json: lights: too many elements (17, at most 16)")

@@ -70,12 +70,20 @@ static void test_round_trips(void)
     enum { N = 2000 };
     veil_particle* p = malloc(N * sizeof *p);
     for (size_t i = 0; i < N; ++i) {
-        for (int k = 0; k < 3; ++k) p[i].center[k] = random_finite();
+        for (int k = 0; k < 3; ++k) {
+            float c = random_finite(); /* every mantissa, within scene/limits.h's 1e15 m */
+            p[i].center[k] = fabsf(c) <= 1e15f ? c : c * (1e15f / 3.4028235e38f);
+        }
         p[i].amplitude = fabsf(random_finite());
         float s = fabsf(random_finite());
-        p[i].sharpness = s > 0 ? s : 1.0f;
+        p[i].sharpness = s >= 1e-29f ? s : 1.0f;
     }
-    p[0].center[0] = -0.0f, p[1].amplitude = 0.0f, p[2].sharpness = 1.4e-45f, p[3].amplitude = 3.4028235e38f;
+    p[0].center[0] = -0.0f, p[1].amplitude = 0.0f, p[2].sharpness = 1e-29f, p[3].amplitude = 3.4028235e38f;
+    /* the longest lines: every field at the largest magnitude it may have, 17 digits each */
+    for (size_t i = 10; i < 1010; ++i) {
+        for (int k = 0; k < 3; ++k) p[i].center[k] = -nextafterf(1e15f, 0.0f);
+        p[i].amplitude = nextafterf(3.4028235e38f, 0.0f), p[i].sharpness = 3.4028235e38f;
+    }
     for (int binary = 0; binary < 2; ++binary) {
         char path[256];
         path_in(path, sizeof path, binary ? "rt.bin" : "rt.json");
@@ -102,6 +110,17 @@ static void test_round_trips(void)
         }
         free(q);
         unlink(path);
+    }
+    /* a centre at -3.4e38: refused by name (it wrote past the JSON buffer: 172 bytes a line, 160 reserved) */
+    for (int binary = 0; binary < 2; ++binary) {
+        char path[256];
+        path_in(path, sizeof path, binary ? "far.bin" : "far.json");
+        veil_particle far = {{-3.4028235e38f, -3.4028235e38f, -3.4028235e38f}, 3.4028235e38f, 3.4028235e38f};
+        veil_error err = {0};
+        CHECK(veil_particles_write(path, &far, 1, binary, &err) == VEIL_ERR_INVALID &&
+                  strstr(err.msg, "particle 0: center[0]") && strstr(err.msg, "[-1e15, 1e15]"),
+              "a centre at -3.4e38: %s", err.msg);
+        CHECK(access(path, F_OK) != 0, "%s written", path);
     }
     /* zero particles, both formats */
     for (int binary = 0; binary < 2; ++binary) {
@@ -149,21 +168,32 @@ static void test_bad_binary(void)
 
     lef(b + 16 + 20 * 2 + 16, -1.0f); /* particle 2: negative sharpness */
     spit(path, b, size);
-    expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 2: sharpness", "expected a finite number > 0, got -1");
+    expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 2: sharpness", "expected a finite number >= 1e-29");
     lef(b + 16 + 20 * 2 + 16, 0.0f);
     spit(path, b, size);
     expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 2: sharpness", "got 0");
-    lef(b + 16 + 20 * 2 + 16, 3.0f);
-    lef(b + 16 + 20 * 1 + 4, NAN); /* particle 1: centre y NaN */
+    /* scene/limits.h: a cut-off radius over 1e15 m (sharpness 1e-30) */
+    lef(b + 16 + 20 * 2 + 16, 1e-30f);
     spit(path, b, size);
-    expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 1: center[1]", "finite");
+    expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 2: sharpness", "got 1e-30");
+    lef(b + 16 + 20 * 2 + 16, 3.0f);
+    lef(b + 16 + 20 * 1 + 4, NAN); /* particle 1: centre y NaN, said so without printing "nan" */
+    spit(path, b, size);
+    expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 1: center[1]", "got not a number");
+    /* a centre at 3.4e38 is finite, but sums with it overflow (it crashed the splat): refused at load */
+    lef(b + 16 + 20 * 1 + 4, 3.4028235e38f);
+    spit(path, b, size);
+    expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 1: center[1]", "[-1e15, 1e15]");
+    lef(b + 16 + 20 * 1 + 4, -1.5e15f);
+    spit(path, b, size);
+    expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 1: center[1]", "got -1.5e+15");
     lef(b + 16 + 20 * 1 + 4, 1.0f);
     lef(b + 16 + 20 * 0 + 12, -0.5f); /* particle 0: negative amplitude */
     spit(path, b, size);
     expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 0: amplitude", ">= 0");
     lef(b + 16 + 20 * 0 + 12, INFINITY);
     spit(path, b, size);
-    expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 0: amplitude", "inf");
+    expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 0: amplitude", "got infinity");
     free(b);
 
     /* the count limit: refused from the header, before any allocation */
@@ -188,7 +218,7 @@ static void test_bad_json(void)
     path_in(path, sizeof path, "bad.json");
     static const struct { const char* text; const char* n1; const char* n2; } cases[] = {
         {"{\"format\":\"veil-particles\",\"version\":1,\"particles\":[{\"center\":[0,0,0],\"amplitude\":1,\"sharpness\":2},"
-         "{\"center\":[0,0,0],\"amplitude\":1,\"sharpness\":-2}]}", "particles[1].sharpness", "expected a number > 0"},
+         "{\"center\":[0,0,0],\"amplitude\":1,\"sharpness\":-2}]}", "particles[1].sharpness", "expected a number >= 1e-29"},
         {"{\"format\":\"veil-particles\",\"version\":1,\"particles\":[{\"center\":[0,0,0],\"amplitude\":-1,\"sharpness\":2}]}",
          "particles[0].amplitude", ">= 0"},
         {"{\"format\":\"veil-particles\",\"version\":1,\"particles\":[{\"center\":[0,1e39,0],\"amplitude\":1,\"sharpness\":2}]}",

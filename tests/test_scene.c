@@ -204,12 +204,22 @@ typedef struct bad_case {
 } bad_case;
 
 static const bad_case BAD[] = {
+    /* scene/limits.h (issue 12): what the float pipeline cannot carry is refused at load, by name */
+    {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'rbf','particles':["
+     "{'center':[3.4e38,0,0],'amplitude':1,'sharpness':1}]}]}}",
+     VEIL_ERR_INVALID, "medium.sources[0].particles[0].center[0]", "expected a number in [-1e15, 1e15] (m: scene/limits.h), got 3.4e+38"},
+    {LIGHTS("{'type':'point','position':[0,0,0],'intensity':[3.4e38,1,1]}"), VEIL_ERR_INVALID,
+     "lights[0].intensity[0]", "expected a number in [0, 1e20] (scene/limits.h), got 3.4e+38"},
+    {"{'camera':{'position':[1e20,0,5],'look_at':[0,0,0],'up':[0,1,0]}," MED "}", VEIL_ERR_INVALID,
+     "camera.position[0]", "[-1e15, 1e15]"},
+    {RND("'count':3,'seed':1,'bounds':[[-1e16,0,0],[1,1,1]],'radius':[1,1],'amplitude':[1,1]"), VEIL_ERR_INVALID,
+     "medium.sources[0].bounds[0][0]", "[-1e15, 1e15]"},
     {"[1,2]", VEIL_ERR_INVALID, NULL, "expected a JSON object at the top level, got an array of 2"},
     {"{" MED "}", VEIL_ERR_INVALID, "camera", "missing required field (an object)"},
     {"{'camera':{'look_at':[0,0,0]}," MED "}", VEIL_ERR_INVALID, "camera.position",
-     "missing required field (an array of 3 numbers)"},
+     "missing required field (an array of 3 numbers, each in [-1e15, 1e15] (m: scene/limits.h))"},
     {"{'camera':{'position':'here','look_at':[0,0,0]}," MED "}", VEIL_ERR_INVALID, "camera.position",
-     "expected an array of 3 numbers, got a string (\"here\")"},
+     "expected an array of 3 numbers, each in [-1e15, 1e15] (m: scene/limits.h), got a string (\"here\")"},
     {"{'camera':{'position':[0,0,1],'look_at':[0,0,0],'fov':40}," MED "}", VEIL_ERR_INVALID, "camera.fov",
      "unknown key (expected one of: position, look_at, up, fov_y_deg, width, height)"},
     {"{'camera':{'position':[0,0,1],'position':[0,0,2],'look_at':[0,0,0]}," MED "}", VEIL_ERR_INVALID,
@@ -255,7 +265,7 @@ static const bad_case BAD[] = {
      "medium.sources[1]", "expected an object, got 7"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'rbf','particles':["
      "{'center':[0,0,0],'amplitude':1,'sharpness':1},{'center':[0,0,0],'amplitude':1,'sharpness':0}]}]}}",
-     VEIL_ERR_INVALID, "medium.sources[0].particles[1].sharpness", "expected a number > 0, got 0"},
+     VEIL_ERR_INVALID, "medium.sources[0].particles[1].sharpness", "expected a number >= 1e-29 (its cut-off radius within 1e15 m: scene/limits.h), got 0"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'rbf','particles':["
      "{'center':[0,0],'amplitude':1,'sharpness':1}]}]}}",
      VEIL_ERR_INVALID, "medium.sources[0].particles[0].center", "expected an array of 3 numbers"},
@@ -286,7 +296,7 @@ static const bad_case BAD[] = {
      "medium.sources[0].particles", "unknown key"},
     {"{" CAM "," MED ",'lights':{}}", VEIL_ERR_INVALID, "lights", "expected an array, got an object"},
     {"{" CAM "," MED ",'lights':[" LIGHT_OK ",{'type':'point','position':[0,0,0],'intensity':'red'}]}",
-     VEIL_ERR_INVALID, "lights[1].intensity", "expected an array of 3 numbers >= 0, got a string (\"red\")"},
+     VEIL_ERR_INVALID, "lights[1].intensity", "expected an array of 3 numbers, each in [0, 1e20] (scene/limits.h), got a string (\"red\")"},
     {"{" CAM "," MED ",'lights':[{'type':'directional','direction':[0,0,0],'irradiance':[1,1,1]}]}",
      VEIL_ERR_INVALID, "lights[0].direction", "expected a non-zero vector"},
     {"{" CAM "," MED ",'lights':[{'type':'area','position':[0,0,0],'intensity':[1,1,1]}]}",
@@ -319,9 +329,9 @@ static const bad_case BAD[] = {
     {SPOT(SPOT_DI "'outer_angle_deg':30,'irradiance':[1,1,1]"), VEIL_ERR_INVALID, "lights[0].irradiance",
      "unknown key (expected one of: type, position, direction, intensity, inner_angle_deg, outer_angle_deg)"},
     {LIGHTS("{'type':'spot','direction':[0,0,1],'intensity':[1,1,1],'outer_angle_deg':30}"), VEIL_ERR_INVALID,
-     "lights[0].position", "missing required field (an array of 3 numbers)"},
+     "lights[0].position", "missing required field (an array of 3 numbers, each in [-1e15, 1e15] (m: scene/limits.h))"},
     {SPOT("'direction':[0,0,1],'intensity':[1,-1,1],'outer_angle_deg':30"), VEIL_ERR_INVALID,
-     "lights[0].intensity[1]", "expected a number >= 0, got -1"},
+     "lights[0].intensity[1]", "expected a number in [0, 1e20] (scene/limits.h), got -1"},
     {LIGHTS(LIGHT_OK ",{'type':'point','position':[0,0,0],'intensity':[1,1,1],'inner_angle_deg':10}"),
      VEIL_ERR_INVALID, "lights[1].inner_angle_deg", "unknown key (expected one of: type, position, intensity)"},
     {LIGHTS("{'type':'point','position':[0,0,0],'intensity':[1,1,1],'outer_angle_deg':30}"), VEIL_ERR_INVALID,
@@ -404,7 +414,7 @@ static void test_exact_messages(void)
     CHECK(strcmp(e.msg, "scene.json: camera.fov: unknown key (expected one of: position, look_at, up, "
                         "fov_y_deg, width, height)") == 0, "%s", e.msg);
     parse("demo.json", "{'camera':{'look_at':[0,0,0]}," MED "}", &s, &e);
-    CHECK(strcmp(e.msg, "demo.json: camera.position: missing required field (an array of 3 numbers)") == 0,
+    CHECK(strcmp(e.msg, "demo.json: camera.position: missing required field (an array of 3 numbers, each in [-1e15, 1e15] (m: scene/limits.h))") == 0,
           "%s", e.msg);
 }
 
