@@ -61,10 +61,12 @@ int veil_opv_method_parse(const char* name, veil_opv_method* out);
 typedef struct veil_opv_light {
     int type;      /* VEIL_LIGHT_POINT (spot lights too) or VEIL_LIGHT_DIRECTIONAL */
     float v[3];    /* point: position (index units); directional: unit vector toward the light */
-    int c[3];      /* point: the light's voxel, floor(v + 1/2) (it may lie outside the grid) */
+    int c[3];      /* point: the light's voxel, floor(v + 1/2) (it may lie outside the grid, at most
+                      VEIL_OPV_FAR voxels beyond it: opv_cpu.c says why that changes nothing) */
 } veil_opv_light;
 
 void veil_opv_light_from_world(const veil_grid* g, const veil_light* l, veil_opv_light* out);
+#define VEIL_OPV_FAR 1048576 /* 2^20 voxels */
 
 /* Jacobi steps between convergence checks (each check is a GPU read-back). */
 #define VEIL_JACOBI_CHECK_EVERY 8

@@ -53,8 +53,13 @@ void veil_opv_light_from_world(const veil_grid* g, const veil_light* l, veil_opv
     for (int a = 0; a < 3; ++a) {
         if (out->type == VEIL_LIGHT_POINT) {
             out->v[a] = (l->position[a] - g->origin[a]) / g->voxel - 0.5f;
+            /* The light's voxel, at most VEIL_OPV_FAR voxels beyond the grid on each axis: further
+             * out, every voxel's distance to it along that axis grows by the same amount, so the
+             * ordered passes take the voxels in the same order, and sums of three such distances
+             * stay far inside int (a light at 1e15 m made them overflow: undefined behaviour). */
             double c = floor((double)out->v[a] + 0.5);
-            out->c[a] = c < -1e9 ? -1000000000 : (c > 1e9 ? 1000000000 : (int)c);
+            double lo = -VEIL_OPV_FAR, hi = (double)g->dims[a] - 1.0 + VEIL_OPV_FAR;
+            out->c[a] = (int)(c < lo ? lo : c > hi ? hi : c);
         } else {
             out->v[a] = -l->direction[a];
         }

@@ -31,6 +31,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "propagate/opv_plan.h"
 #include "propagate/opv.h"
 
 static const veil_opv_method methods[] = {VEIL_OPV_JACOBI, VEIL_OPV_JACOBI_CORRECTED, VEIL_OPV_SWEEP,
@@ -162,8 +163,29 @@ static void test_sl_bound(void)
     free(D);
 }
 
+/* A point light 1e15 m away on every axis (scene/limits.h's largest
+ * position) over a 8^3 grid of 1 cm voxels: its voxel index is 1e17, and
+ * the sweep's shells (Manhattan distances to it) once summed three of them
+ * in int: undefined behaviour (issue 12, defect 7; fatal under UBSan). The
+ * plan must span exactly the grid's 7 + 7 + 7 shells, from a positive first. */
+static void test_far_light(void)
+{
+    veil_grid g = {.dims = {8, 8, 8}, .origin = {0, 0, 0}, .voxel = 0.01f};
+    for (int s = -1; s <= 1; s += 2) {
+        veil_light l = {.type = VEIL_LIGHT_POINT, .position = {s * 1e15f, s * 1e15f, s * 1e15f}, .color = {1, 1, 1}};
+        veil_opv_light ol;
+        veil_opv_light_from_world(&g, &l, &ol);
+        veil__gather_plan p;
+        veil__gather_plan_make(&g, &ol, &p);
+        CHECK(p.first > 0 && p.last - p.first == 21, "light at %g: shells %d .. %d", s * 1e15, p.first, p.last);
+        for (int a = 0; a < 3; ++a)
+            CHECK(s > 0 ? ol.c[a] == 7 + VEIL_OPV_FAR : ol.c[a] == -VEIL_OPV_FAR, "c[%d] = %d", a, ol.c[a]);
+    }
+}
+
 int main(void)
 {
+    test_far_light();
     test_axis_aligned();
     test_sweep_is_fixed_point();
     test_sl_bound();
