@@ -48,6 +48,11 @@ foreach(case native nanovdb filters)
   set_tests_properties(vdb_${case} PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "unit;accuracy")
 endforeach()
 
+# Truncated files fail fast and small, naming the file (tests/vdb_truncated.sh).
+add_test(NAME vdb_truncated COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/vdb_truncated.sh $<TARGET_FILE:veil_cli>
+                                   ${VDB_DATA}/fog_sphere.vdb)
+set_tests_properties(vdb_truncated PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "gpu;bad_input")
+
 # The sparse volume (tests/test_sparse.c): the 4096^3 puffs file against its crop.
 add_executable(test_sparse ${CMAKE_CURRENT_SOURCE_DIR}/test_sparse.c ${CMAKE_CURRENT_SOURCE_DIR}/check.c)
 target_link_libraries(test_sparse PRIVATE veil veil_fp veil_warnings)
