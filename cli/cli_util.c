@@ -7,6 +7,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "io/tempfile.h"
+
 int veil_cli_usage_error(const char* fmt, const char* arg)
 {
     fputs("veil: ", stderr);
@@ -129,6 +131,7 @@ const char* veil_cli_stage(veil_cli_outputs* o, const char* target, veil_error* 
     }
     o->target[i] = target;
     o->count++;
+    veil_temp_register(o->staged[i]); /* a signal removes it (io/tempfile.h) */
     return o->staged[i];
 }
 
@@ -141,6 +144,7 @@ veil_result veil_cli_commit(veil_cli_outputs* o, int ok, veil_error* err)
                           strerror(errno));
         else if (!ok || r != VEIL_OK)
             unlink(o->staged[i]);
+        veil_temp_forget(o->staged[i]);
     }
     o->count = 0;
     return r;

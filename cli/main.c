@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "cli_util.h"
+#include "io/tempfile.h"
 #include "commands.h"
 
 static const char* usage_text =
@@ -101,6 +102,7 @@ static const char* usage_text =
 
 int main(int argc, char** argv)
 {
+    veil_temp_install_signal_cleanup(); /* SIGINT, SIGTERM: no temporary left, exit 130, 143 */
     if (argc < 2) {
         fputs(usage_text, stderr);
         return EXIT_USAGE;

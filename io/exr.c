@@ -333,6 +333,7 @@ veil_result veil_write_exr_planes(const char* path, int width, int height, int n
                            strerror(errno));
     }
     if (result != VEIL_OK) unlink(tmp);
+    veil_temp_forget(tmp);
     free(tmp);
     return result;
 }

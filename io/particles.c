@@ -329,9 +329,11 @@ veil_result veil_particles_write(const char* path, const veil_particle* p, size_
     if (!e && rename(tmp, path) != 0) e = errno;
     if (e) {
         unlink(tmp);
+        veil_temp_forget(tmp);
         free(tmp);
         return veil_fail(err, VEIL_ERR_IO, "%s: cannot write: %s", path, strerror(e));
     }
+    veil_temp_forget(tmp);
     free(tmp);
     return VEIL_OK;
 }

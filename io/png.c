@@ -167,6 +167,7 @@ veil_result veil_write_png_rgb8(const char* path, int width, int height, const u
         int e = errno;
         close(fd);
         unlink(tmp);
+        veil_temp_forget(tmp);
         free(tmp);
         return veil_fail(err, VEIL_ERR_IO, "%s: cannot open a stream on the temporary file: %s", path, strerror(e));
     }
@@ -191,6 +192,7 @@ veil_result veil_write_png_rgb8(const char* path, int width, int height, const u
                                strerror(errno));
     }
     if (result != VEIL_OK) unlink(tmp);
+    veil_temp_forget(tmp);
     free(tmp);
     return result;
 }

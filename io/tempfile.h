@@ -11,4 +11,15 @@
  * replace it. Returns -1 with errno set, or with errno 0 for that refusal. */
 int veil_open_temp_beside(const char* path, char** tmp_out);
 
+/* Files being written that a SIGINT or SIGTERM must not leave behind
+ * (temporaries, a command's staged outputs): at most VEIL_TEMP_SLOTS at a
+ * time. veil_open_temp_beside registers its temporary itself; a writer
+ * calls veil_temp_forget once it has renamed or removed it. */
+#define VEIL_TEMP_SLOTS 16
+void veil_temp_register(const char* path);
+void veil_temp_forget(const char* path);
+/* Installs handlers for SIGINT and SIGTERM that remove every registered
+ * file and exit with 128 + the signal (130, 143), as shells report it. */
+void veil_temp_install_signal_cleanup(void);
+
 #endif

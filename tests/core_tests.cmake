@@ -12,4 +12,5 @@ set_tests_properties(check_layout check_layout_selftest PROPERTIES LABELS unit)
 veil_test(test_spread_width SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_spread_width.c LABELS unit)
 # Blackbody radiance through the CIE curves to Rec.709 (volume/blackbody.h).
 veil_test(test_blackbody SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_blackbody.c LABELS unit)
+veil_test(test_signals SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_signals.c LABELS unit)
 veil_test(test_emission_lights SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_emission_lights.c LABELS unit)

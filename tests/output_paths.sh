@@ -62,5 +62,22 @@ left=$(find "$work" -name '*.veil-staged*' -o -name '*.tmp*' | head -3)
 rm "$work/out.png"
 check "render, both written" 0 "wrote" "$veil" render "$scene" -o "$work/out.exr" --png "$work/out.png" "${small[@]}"
 [ "$(head -c 4 "$work/out.exr" | od -An -tx1 | tr -d ' ')" = "762f3101" ] || { echo "FAIL: out.exr is not an EXR"; fails=$((fails + 1)); }
+# interrupted (issue 12, defect 6): SIGINT exits 130, SIGTERM 143, nothing written, nothing left
+for sig in INT TERM; do
+    "$veil" reference "$scene" -o "$work/long.exr" --spp 1000000 --width 32 --height 24 >/dev/null 2>&1 &
+    pid=$!
+    sleep 1
+    kill -s "$sig" "$pid"
+    wait "$pid"
+    rc=$?
+    want=$([ "$sig" = INT ] && echo 130 || echo 143)
+    left=$(find "$work" -name 'long.exr*' | head -3)
+    if [ "$rc" -ne "$want" ] || [ -n "$left" ]; then
+        echo "FAIL SIG$sig: exit $rc (expected $want), left: $left"
+        fails=$((fails + 1))
+    else
+        echo "PASS SIG$sig: exit $rc, nothing left"
+    fi
+done
 [ $fails -eq 0 ] && echo "PASS: all output-path checks"
 [ $fails -eq 0 ]
