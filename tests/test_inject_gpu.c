@@ -15,28 +15,24 @@
 #include "check.h"
 #include "frame/renderer.h"
 
-int main(void)
+/* Splats d's particles on a grid of `res` voxels a side both ways and
+ * compares them voxel by voxel within the bound above. */
+static void compare(veil_renderer* r, const veil_rbf_random_desc* d, int res)
 {
-    veil_gl* gl = check_gpu_or_skip();
-    veil_renderer* r = NULL;
     veil_error err = {0};
-    CHECK(veil_renderer_create(gl, &r, &err) == VEIL_OK, "%s", err.msg);
-
-    veil_rbf_random_desc d = {.count = 400, .seed = 11, .bounds = {{0, 0, 0}, {1.3f, 1.0f, 0.8f}},
-                              .radius = {0.03f, 0.15f}, .amplitude = {0.2f, 3.0f}};
-    veil_particle* p = malloc(d.count * sizeof *p);
-    veil_rbf_random_generate(&d, p);
+    veil_particle* p = malloc(d->count * sizeof *p);
+    veil_rbf_random_generate(d, p);
     float lo[3], hi[3];
-    veil_rbf_bounds(p, d.count, lo, hi);
+    veil_rbf_bounds(p, d->count, lo, hi);
     veil_grid g;
-    veil_grid_fit(lo, hi, 37, &g, &err);
+    veil_grid_fit(lo, hi, res, &g, &err);
     size_t nv = veil_grid_voxels(&g);
     float* cpu = calloc(nv, sizeof(float));
     float* gpu = malloc(nv * sizeof(float));
     veil_rbf_bins bins;
-    veil_rbf_bin(&g, p, d.count, &bins, &err);
+    CHECK(veil_rbf_bin(&g, p, d->count, &bins, &err) == VEIL_OK, "%s", err.msg);
     veil_inject_rbf_cpu(&g, &bins, cpu);
-    CHECK(veil_renderer_inject(r, &g, p, d.count, gpu, &err) == VEIL_OK, "%s", err.msg);
+    CHECK(veil_renderer_inject(r, &g, p, d->count, gpu, &err) == VEIL_OK, "%s", err.msg);
 
     int bad = 0;
     double worst = 0.0, total = 0.0;
@@ -52,14 +48,31 @@ int main(void)
                 if (cpu[v] > 0) worst = fmax(worst, e / cpu[v]);
                 total += cpu[v];
             }
-    printf("%dx%dx%d voxels, %u particles: largest relative GPU-CPU difference %.3g\n", g.dims[0], g.dims[1],
-           g.dims[2], d.count, worst);
+    printf("%dx%dx%d voxels, %u particles, %.3g evaluations (dispatches of at most %.3g): largest relative GPU-CPU "
+           "difference %.3g\n", g.dims[0], g.dims[1], g.dims[2], d->count, (double)bins.list_len * 512,
+           (double)VEIL_SPLAT_DISPATCH_EVALS, worst);
     CHECK(total > 0.0, "empty volume");
     CHECK(bad == 0, "%d voxels differ beyond the exp() error bound", bad);
     veil_rbf_bins_free(&bins);
     free(cpu);
     free(gpu);
     free(p);
+}
+
+int main(void)
+{
+    veil_gl* gl = check_gpu_or_skip();
+    veil_renderer* r = NULL;
+    veil_error err = {0};
+    CHECK(veil_renderer_create(gl, &r, &err) == VEIL_OK, "%s", err.msg);
+    veil_rbf_random_desc small = {.count = 400, .seed = 11, .bounds = {{0, 0, 0}, {1.3f, 1.0f, 0.8f}},
+                                  .radius = {0.03f, 0.15f}, .amplitude = {0.2f, 3.0f}};
+    compare(r, &small, 37);
+    /* particles nearly as large as the grid: 3e8 evaluations, more than one dispatch of
+     * VEIL_SPLAT_DISPATCH_EVALS (2.7e8): the layers of bricks each dispatch takes must still add up */
+    veil_rbf_random_desc big = {.count = 1600, .seed = 5, .bounds = {{0, 0, 0}, {1, 1, 1}},
+                                .radius = {0.6f, 0.8f}, .amplitude = {0.01f, 0.02f}};
+    compare(r, &big, 64);
     veil_renderer_destroy(r);
     veil_gl_destroy(gl);
     return check_finish();

@@ -205,7 +205,8 @@ static void test_types(void)
 
 static void test_bad_files(void)
 {
-    open_fails("truncated.vdb", NULL, 0, VEIL_ERR_IO, (const char* const[]){"truncated.vdb", "OpenVDB said", NULL});
+    open_fails("truncated.vdb", NULL, 0, VEIL_ERR_IO,
+               (const char* const[]){"truncated.vdb", "truncated or corrupt OpenVDB file", "does not fit in its", NULL});
     open_fails("garbage.vdb", NULL, 0, VEIL_ERR_IO, (const char* const[]){"garbage.vdb", "OpenVDB said", NULL});
     open_fails("does_not_exist.vdb", NULL, 0, VEIL_ERR_IO,
                (const char* const[]){"does_not_exist.vdb", "No such file or directory", NULL});

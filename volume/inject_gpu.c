@@ -20,9 +20,29 @@ veil_result veil_inject_rbf_gpu(GLuint program, const veil_grid* g, const veil_r
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_BRICK_START, buf[1]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_BRICK_LIST, buf[2]);
         glBindImageTexture(VEIL_IMAGE_EV, ev_texture, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
-        glDispatchCompute((GLuint)b->bricks[0], (GLuint)b->bricks[1], (GLuint)b->bricks[2]);
-        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
-                        GL_TEXTURE_UPDATE_BARRIER_BIT);
+        /* layers of bricks, as many per dispatch as keep its particle-voxel evaluations under
+         * VEIL_SPLAT_DISPATCH_EVALS (a GPU watchdog stops a dispatch of a few seconds; each
+         * layer alone is under it whenever the whole splat is under VEIL_SPLAT_MAX_EVALS) */
+        GLint first_z = glGetUniformLocation(program, "u_first_z");
+        size_t layer = (size_t)b->bricks[0] * (size_t)b->bricks[1];
+        int z = 0;
+        while (z < b->bricks[2]) {
+            int z1 = z;
+            size_t work = 0;
+            do {
+                work += (size_t)(b->start[layer * (size_t)(z1 + 1)] - b->start[layer * (size_t)z1]) *
+                        VEIL_BRICK * VEIL_BRICK * VEIL_BRICK;
+                ++z1;
+            } while (z1 < b->bricks[2] &&
+                     work + (size_t)(b->start[layer * (size_t)(z1 + 1)] - b->start[layer * (size_t)z1]) *
+                                VEIL_BRICK * VEIL_BRICK * VEIL_BRICK <= VEIL_SPLAT_DISPATCH_EVALS);
+            glProgramUniform1i(program, first_z, z);
+            glDispatchCompute((GLuint)b->bricks[0], (GLuint)b->bricks[1], (GLuint)(z1 - z));
+            glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                            GL_TEXTURE_UPDATE_BARRIER_BIT);
+            glFlush();
+            z = z1;
+        }
         for (GLuint i = 0; i < 3; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_PARTICLES + i, 0);
         glBindImageTexture(VEIL_IMAGE_EV, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
         glUseProgram(0);

@@ -102,12 +102,22 @@ veil_result veil_rbf_bin(const veil_grid* g, const veil_particle* p, size_t n,
                 for (int x = b0[0]; x <= b1[0]; ++x) {
                     size_t b = ((size_t)z * out->bricks[1] + y) * out->bricks[0] + x;
                     out->start[b + 1]++;
-                    if (++total > UINT32_MAX)
+                    if (++total > VEIL_SPLAT_MAX_ENTRIES)
                         return veil_rbf_bins_free(out),
                                veil_fail(err, VEIL_ERR_LIMIT,
-                                         "particle footprints cover more than 2^32 brick entries; "
-                                         "lower max_resolution or the particle radii");
+                                         "%zu particles' footprints cover more than %zu brick entries (the lists "
+                                         "would take over 1 GiB; the splat over %.3g particle-voxel evaluations): "
+                                         "fewer or smaller particles, or a lower medium.max_resolution", n,
+                                         VEIL_SPLAT_MAX_ENTRIES, (double)VEIL_SPLAT_MAX_ENTRIES * 512.0);
                 }
+    }
+    if (total * VEIL_BRICK * VEIL_BRICK * VEIL_BRICK > VEIL_SPLAT_MAX_EVALS) {
+        veil_rbf_bins_free(out);
+        return veil_fail(err, VEIL_ERR_LIMIT,
+                         "%zu particles over %zu brick entries: the splat would evaluate %.3g Gaussians (512 a "
+                         "brick entry), over the limit of %.3g (about half a minute on a CPU driver): fewer or "
+                         "smaller particles, or a lower medium.max_resolution", n, total,
+                         (double)total * 512.0, (double)VEIL_SPLAT_MAX_EVALS);
     }
     for (size_t b = 0; b < nb; ++b) out->start[b + 1] += out->start[b];
     out->list_len = total;

@@ -53,6 +53,18 @@ typedef struct veil_rbf_bins {
     size_t particle_count;
 } veil_rbf_bins;
 
+/* The splat's work, known once the particles are binned: every voxel of a
+ * brick evaluates every particle of its list, 512 x (list entries)
+ * Gaussians. Above VEIL_SPLAT_MAX_EVALS (about half a minute on a CPU
+ * driver at ~1e9 a second; 10^7 particles of a few bricks each come to
+ * ~1e11) the bin is refused with the numbers, before any memory is taken
+ * for the lists; VEIL_SPLAT_MAX_ENTRIES bounds the lists' memory (1 GiB).
+ * The GPU splat is split into dispatches of at most VEIL_SPLAT_DISPATCH_EVALS
+ * (a brick layer more when one layer holds more). */
+#define VEIL_SPLAT_MAX_EVALS ((size_t)1 << 35)
+#define VEIL_SPLAT_MAX_ENTRIES ((size_t)1 << 28)
+#define VEIL_SPLAT_DISPATCH_EVALS ((size_t)1 << 28)
+
 veil_result veil_rbf_bin(const veil_grid* g, const veil_particle* p, size_t n,
                          veil_rbf_bins* out, veil_error* err);
 void veil_rbf_bins_free(veil_rbf_bins* b);

@@ -20,12 +20,13 @@ uniform ivec3 u_dims;
 uniform ivec3 u_bricks;
 uniform vec3 u_origin;
 uniform float u_voxel;
+uniform int u_first_z; // this dispatch's first layer of bricks (the splat is split to bound each dispatch's work)
 
 void main()
 {
-    ivec3 v = ivec3(gl_GlobalInvocationID);
+    ivec3 b = ivec3(gl_WorkGroupID) + ivec3(0, 0, u_first_z);
+    ivec3 v = b * VEIL_BRICK + ivec3(gl_LocalInvocationID);
     if (any(greaterThanEqual(v, u_dims))) return;
-    ivec3 b = ivec3(gl_WorkGroupID);
     uint brick = uint((b.z * u_bricks.y + b.y) * u_bricks.x + b.x);
     precise vec3 x = u_origin + (vec3(v) + 0.5) * u_voxel;
     precise float sum = imageLoad(u_ev, v).r;
