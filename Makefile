@@ -5,10 +5,18 @@
 #   make data   generate the VDBs that data/scenes/vdb_smoke.json and pyro.json render
 #   make accuracy  time against error of the GPU path vs the CPU reference
 #                  (bench/accuracy --quick, under 2 minutes; FULL=1: the full sweep)
+#   make fuzz   libFuzzer on the scene parser, the particle readers, the EXR and
+#               the OpenVDB readers, FUZZ_SECONDS each (default 60), under ASan and
+#               UBSan, in build-fuzz/ (scripts/fuzz.sh)
+#   make test-sanitize  every test built with AddressSanitizer and UndefinedBehaviorSanitizer
+#                  (undefined behaviour fatal) in build-sanitize/; leaks in Mesa and LLVM
+#                  (the GL driver) suppressed by tests/lsan.supp, never veil's; the driver is
+#                  preloaded, so never unloaded, so its leaks have names to suppress
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
-.PHONY: all deps build demo test data clean accuracy
+.PHONY: all deps build demo test data clean accuracy test-sanitize fuzz
+FUZZ_SECONDS ?= 60
 
 all: build
 
@@ -47,5 +55,23 @@ accuracy:
 	@test -f data/generated/smoke_plume.vdb || $(MAKE) --no-print-directory data
 	@$(BUILD)/bench/accuracy $(if $(FULL),,--quick) $(ACCURACY_ARGS)
 
+test-sanitize:
+	@$(MAKE) --no-print-directory deps
+	@cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVEIL_SANITIZE=ON >/dev/null
+	@cmake --build build-sanitize -j $(JOBS) -- --no-print-directory
+	@cd build-sanitize && LD_PRELOAD=$(wildcard /usr/lib/$(shell gcc -print-multiarch)/dri/swrast_dri.so) \
+	  ASAN_OPTIONS=detect_leaks=1:verify_asan_link_order=0 \
+	  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
+	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j $(JOBS)
+
+fuzz:
+	@$(MAKE) --no-print-directory deps
+	@bash scripts/install-bench-deps.sh clang
+	@CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVEIL_FUZZ=ON \
+	  -DVEIL_SANITIZE=ON >/dev/null
+	@cmake --build build-fuzz -j $(JOBS) --target fuzz_scene fuzz_particles fuzz_exr fuzz_vdb make_test_vdbs \
+	  make_compare_exrs veil_cli -- --no-print-directory
+	@bash scripts/fuzz.sh build-fuzz $(FUZZ_SECONDS)
+
 clean:
-	rm -rf $(BUILD) out
+	rm -rf $(BUILD) build-sanitize build-fuzz out
