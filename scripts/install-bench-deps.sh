@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages the benchmarks need beyond scripts/install-deps.sh:
-# gnuplot (no X11) for bench/accuracy's time-error plot. Idempotent: silent
-# when everything is present. Run by a user who is not root, it prints the
-# exact command to run and stops.
+# Installs the Debian 12 packages the benchmarks and tools need beyond
+# scripts/install-deps.sh: by default gnuplot (no X11) for bench/accuracy's
+# time-error plot; with arguments, those packages instead (`make fuzz`:
+# clang, whose libFuzzer tests/fuzz/ needs). Idempotent: silent when
+# everything is present. Run by a user who is not root, it prints the exact
+# command to run and stops.
 set -euo pipefail
 
 packages=(
   gnuplot-nox   # bench/accuracy: docs/results/accuracy*.png
 )
+[ $# -gt 0 ] && packages=("$@")
 
 missing=()
 for p in "${packages[@]}"; do
@@ -17,7 +20,7 @@ done
 [ ${#missing[@]} -eq 0 ] && exit 0
 
 if [ "$(id -u)" -ne 0 ]; then
-  echo "the veil benchmarks need these Debian packages: ${missing[*]}" >&2
+  echo "the veil benchmarks and tools need these Debian packages: ${missing[*]}" >&2
   echo "install them with:" >&2
   echo "  sudo apt-get update && sudo apt-get install -y ${missing[*]}" >&2
   exit 1
