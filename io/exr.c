@@ -582,6 +582,10 @@ static veil_result read_channels(exr_const_context_t ctx, const char* path, cons
     if (w <= 0 || h <= 0 || w > INT_MAX || h > INT_MAX)
         return veil_fail(err, VEIL_ERR_IO, "%s: invalid OpenEXR data window (%d, %d)-(%d, %d)", path, dw.min.x,
                          dw.min.y, dw.max.x, dw.max.y);
+    /* a bound on what an untrusted header can make us allocate before any pixel is read */
+    if ((uint64_t)w * (uint64_t)h > VEIL_EXR_MAX_PIXELS)
+        return veil_fail(err, VEIL_ERR_LIMIT, "%s: OpenEXR image %" PRId64 "x%" PRId64 " has more than 2^26 pixels (an "
+                         "8192x8192 image), the most veil reads", path, w, h);
     size_t bytes = 0;
     if (!veil_mul_sizes((size_t)w, (size_t)h, (size_t)n, sizeof(float), &bytes) ||
         (uint64_t)w > (uint64_t)INT32_MAX / ((size_t)n * sizeof(float)))

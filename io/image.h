@@ -9,6 +9,8 @@
 #ifndef VEIL_IMAGE_H
 #define VEIL_IMAGE_H
 
+#include <stdint.h>
+
 #include "../core/result.h"
 
 /* EXR with channels R, G, B, A stored as 32-bit float, ZIP compression. */
@@ -30,9 +32,15 @@ veil_result veil_write_exr_planes(const char* path, int width, int height, int n
 veil_result veil_read_exr_channel(const char* path, const char* name, int* width, int* height, float** plane,
                                   veil_error* err);
 
+/* At most this many pixels are read from an EXR (its header says how many
+ * before any pixel is decoded: an untrusted file must not make veil
+ * allocate gigabytes): 2^26, an 8192 x 8192 image, 1 GiB as RGBA float. */
+#define VEIL_EXR_MAX_PIXELS ((uint64_t)1 << 26)
+
 /* Reads an EXR's R, G, B, A channels (A = 1 when absent) as float into a
  * newly malloc'd buffer *rgba (free() it). Any scanline or tiled EXR that
- * OpenEXRCore decodes with half or float channels. */
+ * OpenEXRCore decodes with half or float channels, up to
+ * VEIL_EXR_MAX_PIXELS (VEIL_ERR_LIMIT). */
 veil_result veil_read_exr(const char* path, int* width, int* height,
                           float** rgba, veil_error* err);
 

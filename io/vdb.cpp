@@ -109,7 +109,8 @@ void check_readable(const std::string& path)
 //   name and a type (uint32 length + chars each) and a value (uint32 size +
 //   bytes); then, with grid offsets, int32 grid count and per grid its
 //   unique name, type and (216+) instance parent (strings), and int64 grid,
-//   block and end positions, the next descriptor at the end position.
+//   block and end positions, the next descriptor at the end position; each
+//   grid's own header (grid_header below) within its grid..block bytes.
 // Every length, count and position must fit in what is left of the file.
 class header_check {
 public:
@@ -149,12 +150,46 @@ public:
                               (unsigned long long)end);
                 bad(what, end);
             }
+            grid_header(version, grid, block);
+            in_.clear();
             in_.seekg((std::streamoff)end);
             at_ = end;
         }
     }
 
 private:
+    // A grid's own header, bytes [grid, block): (222+) uint32 compression, its
+    // metadata as the file's, then the transform's type name. The values of
+    // "__delayedload" metadata start with a count of entries of at least a
+    // byte each, which OpenVDB sizes vectors by.
+    void grid_header(uint32_t version, uint64_t grid, uint64_t block)
+    {
+        uint64_t saved = size_;
+        in_.clear();
+        in_.seekg((std::streamoff)grid);
+        at_ = grid;
+        size_ = block; // nothing of the header may reach past its block
+        if (version >= 222) skip(4, "a grid's compression flags");
+        uint32_t entries = u32();
+        if ((uint64_t)entries * 12 > left()) bad("a grid's metadata count", entries);
+        for (uint32_t e = 0; e < entries; ++e) {
+            string("a grid's metadata name");
+            uint32_t type_len = u32();
+            std::string type(bytes(type_len, "a grid's metadata type"), type_len);
+            uint32_t value = u32();
+            if (value > left()) bad("a grid's metadata value", value);
+            if (type == "__delayedload" && value >= 4) {
+                uint32_t count = u32();
+                if (count > value) bad("a delayed-load count", count);
+                skip(value - 4, "a grid's metadata value");
+            } else {
+                skip(value, "a grid's metadata value");
+            }
+        }
+        string("a grid's transform type");
+        size_ = saved;
+    }
+
     [[noreturn]] void bad(const char* what, uint64_t value)
     {
         char msg[400];

@@ -53,6 +53,12 @@ add_test(NAME vdb_truncated COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/vdb_truncat
                                    ${VDB_DATA}/fog_sphere.vdb)
 set_tests_properties(vdb_truncated PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "gpu;bad_input")
 
+# The fuzz corpus (tests/fuzz/corpus/: seeds and the inputs fuzzing found) as
+# regression inputs of every build (tests/fuzz_corpus.sh).
+add_test(NAME fuzz_corpus COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/fuzz_corpus.sh $<TARGET_FILE:veil_cli>
+                                 ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/corpus)
+set_tests_properties(fuzz_corpus PROPERTIES LABELS "bad_input")
+
 # The sparse volume (tests/test_sparse.c): the 4096^3 puffs file against its crop.
 add_executable(test_sparse ${CMAKE_CURRENT_SOURCE_DIR}/test_sparse.c ${CMAKE_CURRENT_SOURCE_DIR}/check.c)
 target_link_libraries(test_sparse PRIVATE veil veil_fp veil_warnings)
