@@ -129,13 +129,7 @@ public:
         bool offsets = bytes(1, "the grid-offsets flag")[0] != 0;
         if (version < 222) skip(1, "the compression flag");
         skip(36, "the UUID");
-        uint32_t entries = u32();
-        if ((uint64_t)entries * 12 > left()) bad("the metadata count", entries);
-        for (uint32_t i = 0; i < entries; ++i) {
-            string("a metadata name");
-            string("a metadata type");
-            skip(u32(), "a metadata value");
-        }
+        metadata("the file's");
         if (!offsets) return;
         int32_t grids = (int32_t)u32();
         if (grids < 0 || (uint64_t)grids * 36 > left()) bad("the grid count", (uint64_t)(uint32_t)grids);
@@ -158,10 +152,47 @@ public:
     }
 
 private:
+    // A metadata block as OpenVDB's MetaMap reads it: uint32 count, then per
+    // entry a name, a type and uint32 size + value. OpenVDB reads a value of
+    // a fixed-size type (int32, vec3i, mat4d, ...) by the type's size, not by
+    // the stored one, so the two must agree or the reading goes astray (and
+    // takes later bytes for string lengths); a "__delayedload" value starts
+    // with a count of entries of at least a byte each, which sizes vectors.
+    void metadata(const char* whose)
+    {
+        static const std::pair<const char*, uint32_t> fixed[] = {
+            {"bool", 1},   {"int32", 4},  {"int64", 8},   {"float", 4},  {"double", 8}, {"vec2i", 8},
+            {"vec2s", 8},  {"vec2d", 16}, {"vec3i", 12},  {"vec3s", 12}, {"vec3d", 24}, {"vec4i", 16},
+            {"vec4s", 16}, {"vec4d", 32}, {"mat4s", 64},  {"mat4d", 128}};
+        std::string what = std::string(whose) + " metadata";
+        uint32_t entries = u32();
+        if ((uint64_t)entries * 12 > left()) bad((what + " count").c_str(), entries);
+        for (uint32_t e = 0; e < entries; ++e) {
+            string((what + " name").c_str());
+            uint32_t type_len = u32();
+            std::string type(bytes(type_len, (what + " type").c_str()), type_len);
+            uint32_t value = u32();
+            if (value > left()) bad((what + " value").c_str(), value);
+            for (const auto& f : fixed)
+                if (type == f.first && value != f.second) {
+                    char msg[300];
+                    std::snprintf(msg, sizeof msg, ": corrupt OpenVDB file: %s value of type %s has %u bytes where the "
+                                  "type has %u (at byte %llu)", what.c_str(), type.c_str(), value, f.second,
+                                  (unsigned long long)at_);
+                    fail_with(VEIL_ERR_IO, path_ + msg);
+                }
+            if (type == "__delayedload" && value >= 4) {
+                uint32_t count = u32();
+                if ((uint64_t)count + 4 > value) bad("a delayed-load count", count);
+                skip(value - 4, what.c_str());
+            } else {
+                skip(value, what.c_str());
+            }
+        }
+    }
+
     // A grid's own header, bytes [grid, block): (222+) uint32 compression, its
-    // metadata as the file's, then the transform's type name. The values of
-    // "__delayedload" metadata start with a count of entries of at least a
-    // byte each, which OpenVDB sizes vectors by.
+    // metadata, then the transform's type name.
     void grid_header(uint32_t version, uint64_t grid, uint64_t block)
     {
         uint64_t saved = size_;
@@ -170,22 +201,7 @@ private:
         at_ = grid;
         size_ = block; // nothing of the header may reach past its block
         if (version >= 222) skip(4, "a grid's compression flags");
-        uint32_t entries = u32();
-        if ((uint64_t)entries * 12 > left()) bad("a grid's metadata count", entries);
-        for (uint32_t e = 0; e < entries; ++e) {
-            string("a grid's metadata name");
-            uint32_t type_len = u32();
-            std::string type(bytes(type_len, "a grid's metadata type"), type_len);
-            uint32_t value = u32();
-            if (value > left()) bad("a grid's metadata value", value);
-            if (type == "__delayedload" && value >= 4) {
-                uint32_t count = u32();
-                if (count > value) bad("a delayed-load count", count);
-                skip(value - 4, "a grid's metadata value");
-            } else {
-                skip(value, "a grid's metadata value");
-            }
-        }
+        metadata("a grid's");
         string("a grid's transform type");
         size_ = saved;
     }
