@@ -18,6 +18,7 @@
 
 #include "cli_util.h"
 #include "io/tempfile.h"
+#include "io/vdb.h"
 #include "commands.h"
 
 static const char* usage_text =
@@ -103,6 +104,7 @@ static const char* usage_text =
 int main(int argc, char** argv)
 {
     veil_temp_install_signal_cleanup(); /* SIGINT, SIGTERM: no temporary left, exit 130, 143 */
+    veil_vdb_limit_reads(1);            /* a corrupt VDB fails instead of taking gigabytes */
     if (argc < 2) {
         fputs(usage_text, stderr);
         return EXIT_USAGE;

@@ -17,7 +17,9 @@
 #include <tbb/parallel_for.h>
 
 #include <cJSON.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -60,6 +62,58 @@ struct failure {
 
 [[noreturn]] void fail_with(veil_result code, std::string msg) { throw failure{code, std::move(msg)}; }
 
+#if defined(__SANITIZE_ADDRESS__)
+#define VEIL_UNDER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define VEIL_UNDER_ASAN 1
+#endif
+#endif
+
+bool g_limit_reads = false;       // veil_vdb_limit_reads
+unsigned long long g_budget = 0;  // the address-space limit of the read under way (0: none)
+
+// While a file is read, the process's address space is limited to what it
+// uses plus 1 GiB plus 64 times the file's size, when veil_vdb_limit_reads
+// asked for it (the CLI does): OpenVDB takes buffer sizes inside the trees
+// (blosc and zip chunks) from the file and allocates them before reading,
+// and a corrupt one asked for 10 GB. Not under AddressSanitizer, whose
+// shadow memory reserves terabytes of address space.
+class read_budget {
+public:
+    explicit read_budget(const std::string& path)
+    {
+#ifndef VEIL_UNDER_ASAN
+        struct stat st;
+        if (!g_limit_reads || stat(path.c_str(), &st) != 0) return;
+        unsigned long long pages = 0;
+        if (FILE* f = std::fopen("/proc/self/statm", "r")) {
+            if (std::fscanf(f, "%llu", &pages) != 1) pages = 0;
+            std::fclose(f);
+        }
+        if (!pages || getrlimit(RLIMIT_AS, &old_) != 0) return;
+        unsigned long long limit = pages * (unsigned long long)sysconf(_SC_PAGESIZE) + (1ull << 30) +
+                                   64ull * (unsigned long long)st.st_size;
+        if (old_.rlim_cur != RLIM_INFINITY && old_.rlim_cur <= limit) return; // never loosened
+        struct rlimit r = old_;
+        r.rlim_cur = limit;
+        if (setrlimit(RLIMIT_AS, &r) == 0) active_ = true, g_budget = limit;
+#else
+        (void)path;
+#endif
+    }
+    ~read_budget()
+    {
+        if (active_) setrlimit(RLIMIT_AS, &old_); // g_budget stays for guarded()'s message; it clears it
+    }
+    read_budget(const read_budget&) = delete;
+    read_budget& operator=(const read_budget&) = delete;
+
+private:
+    struct rlimit old_ = {0, 0};
+    bool active_ = false;
+};
+
 std::string quoted(const std::string& s) { return "'" + s + "'"; }
 
 // Runs f, mapping every exception to a result: `what` prefixes the messages
@@ -67,12 +121,18 @@ std::string quoted(const std::string& s) { return "'" + s + "'"; }
 template <typename F>
 veil_result guarded(veil_error* err, const char* what, F&& f) noexcept
 {
+    struct clear_budget {
+        ~clear_budget() { g_budget = 0; }
+    } clear;
     try {
         f();
         return VEIL_OK;
     } catch (const failure& e) {
         return veil_fail(err, e.code, "%s", e.msg.c_str());
     } catch (const std::bad_alloc&) {
+        if (g_budget)
+            return veil_fail(err, VEIL_ERR_IO, "%s: corrupt OpenVDB file: reading it asked for more memory than a file "
+                             "of its size can need (the budget: %llu MiB)", what, g_budget >> 20);
         return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory while reading the OpenVDB file", what);
     } catch (const openvdb::Exception& e) {
         return veil_fail(err, VEIL_ERR_IO, "%s: cannot read the OpenVDB file (OpenVDB said: %s)", what, e.what());
@@ -491,6 +551,7 @@ veil_result veil_vdb_open(const char* path, const char* grid_name, int level_set
     if (!path || !out) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_open: path and out are required");
     veil_vdb* v = nullptr;
     veil_result r = guarded(err, path, [&] {
+        read_budget budget(path);
         const bool nano = is_nanovdb(path);
         openvdb::io::File file(path);
         openvdb::GridPtrVec metas = file_grids(file, path, nano);
@@ -519,6 +580,8 @@ veil_result veil_vdb_open(const char* path, const char* grid_name, int level_set
     *out = v;
     return VEIL_OK;
 }
+
+void veil_vdb_limit_reads(int on) { g_limit_reads = on != 0; }
 
 void veil_vdb_close(veil_vdb* v)
 {
@@ -614,6 +677,7 @@ veil_result veil_vdb_file_info(const char* path, veil_vdb_grid_info** grids, siz
     veil_vdb_grid_info* out = nullptr;
     size_t n = 0;
     veil_result r = guarded(err, path, [&] {
+        read_budget budget(path);
         const bool nano = is_nanovdb(path);
         openvdb::io::File file(path);
         openvdb::GridPtrVec metas = file_grids(file, path, nano);

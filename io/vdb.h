@@ -55,6 +55,15 @@ veil_result veil_vdb_open(const char* path, const char* grid_name, int level_set
 /* Accepts NULL. */
 void veil_vdb_close(veil_vdb* v);
 
+/* From now on, reading a file (veil_vdb_open, veil_vdb_file_info) limits
+ * the process's address space for the time of the read to what it uses
+ * plus 1 GiB plus 64 times the file's size (setrlimit, restored after):
+ * OpenVDB allocates buffer sizes it reads from inside the trees, and a
+ * corrupt file then fails with VEIL_ERR_IO instead of taking gigabytes.
+ * Process-wide, so a program opts in (the CLI does); off under
+ * AddressSanitizer. */
+void veil_vdb_limit_reads(int on);
+
 /* The file and grid name, for messages (owned by v). */
 const char* veil_vdb_path(const veil_vdb* v);
 const char* veil_vdb_grid_name(const veil_vdb* v);
