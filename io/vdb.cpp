@@ -170,6 +170,14 @@ void open_file(openvdb::io::File& file, const std::string& path)
     file.open(false);
 }
 
+// Before OpenVDB reads a grid's tree: the tree's counts, masks and chunk
+// sizes checked against the grid's bytes (io/vdb_header.cpp).
+void check_tree(const std::string& path, const std::string& grid)
+{
+    std::string why;
+    if (!veil__vdb_tree_ok(path, grid, &why)) fail_with(VEIL_ERR_IO, path + ": " + why);
+}
+
 std::string class_name(const GridBase& g)
 {
     switch (g.getGridClass()) {
@@ -311,7 +319,7 @@ char* dup_c(const std::string& s)
     return p;
 }
 
-void fill_info(openvdb::io::File* file, const GridBase& meta, veil_vdb_grid_info& gi)
+void fill_info(const std::string& path, openvdb::io::File* file, const GridBase& meta, veil_vdb_grid_info& gi)
 {
     gi.name = dup_c(meta.getName());
     copy_name(class_name(meta), gi.grid_class, sizeof gi.grid_class);
@@ -331,6 +339,7 @@ void fill_info(openvdb::io::File* file, const GridBase& meta, veil_vdb_grid_info
         count = (openvdb::Index64)cnt->value();
         box = CoordBBox(Coord(bmin->value()), Coord(bmax->value()));
     } else { // written without statistics: read the tree
+        check_tree(path, meta.getName());
         GridBase::Ptr g = file->readGrid(meta.getName());
         count = g->activeVoxelCount();
         box = g->evalActiveVoxelBoundingBox();
@@ -418,6 +427,7 @@ veil_result veil_vdb_open(const char* path, const char* grid_name, int level_set
                       where + " is a level set (a signed distance to a surface, not a density); add \"level_set\": "
                               "\"to_fog\" to the vdb source to convert it into a fog volume when it is read, or "
                               "convert the file with vdb_tool -ls2fog");
+        if (!nano) check_tree(path, name);
         FloatGrid::Ptr grid = openvdb::gridPtrCast<FloatGrid>(nano ? meta : file.readGrid(name));
         if (!nano) file.close();
         if (!grid) fail_with(VEIL_ERR_IO, where + ": OpenVDB returned no float grid");
@@ -536,7 +546,7 @@ veil_result veil_vdb_file_info(const char* path, veil_vdb_grid_info** grids, siz
         openvdb::GridPtrVec metas = file_grids(file, path, nano);
         out = static_cast<veil_vdb_grid_info*>(std::calloc(metas.size() ? metas.size() : 1, sizeof *out));
         if (!out) throw std::bad_alloc();
-        for (const auto& m : metas) fill_info(nano ? nullptr : &file, *m, out[n++]);
+        for (const auto& m : metas) fill_info(path, nano ? nullptr : &file, *m, out[n++]);
         if (!nano) file.close();
     });
     if (r != VEIL_OK) {

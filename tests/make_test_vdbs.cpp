@@ -30,6 +30,12 @@
 //   smoke_plume.vdb      "density": a procedural noisy plume, ~10^5 active voxels, hard edges
 //   truncated.vdb        the first half of fog_sphere.vdb's bytes
 //   garbage.vdb          bytes that are not an OpenVDB file
+//   types_blosc.vdb, types_zip.vdb, types_raw.vdb, types_half.vdb (tree_files below):
+//                        a grid of each value type OpenVDB registers for voxels, a level
+//                        set and an instance, under each compression, without stats
+//                        metadata (so reading the file's statistics reads every tree)
+//   chunk_big.vdb, chunk_raw.vdb, chunk_header.vdb, root_count.vdb: one small grid each,
+//                        with one claim of its tree made absurd (tree_files below)
 //
 // The values that tests/test_vdb.c recomputes (the linear field, the two
 // grids' voxel counts) are stated in the comments next to them.
@@ -47,6 +53,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -204,6 +212,8 @@ void sparse_pair()
     write("sparse_crop.vdb", {part});
 }
 
+void tree_files(); // below: the tree files
+
 void make_all(bool big)
 {
     const float sphere_voxel = 0.05f, sphere_radius = 1.0f; // 20 voxels
@@ -300,9 +310,178 @@ void make_all(bool big)
     write("smoke_plume.vdb", {plume(1.0)});
     if (big) write("big_plume.vdb", {plume(2.2)});
 
+    tree_files();
+
     std::ofstream garbage(path("garbage.vdb"), std::ios::binary);
     for (int i = 0; i < 64; ++i) garbage << "this is not an OpenVDB file\n";
     if (!garbage) throw std::runtime_error("cannot write " + path("garbage.vdb"));
+}
+
+// A grid of `G` named `name`: value `a` at 37 x 15 x 10 scattered voxels
+// (x -40..68 step 3, y 0..196 step 14, z 0..117 step 13: 5 550 active
+// voxels in 2 100 leaves, so that OpenVDB's delayed-load metadata
+// compresses its per-leaf arrays), an active tile of 8^3 = 512 voxels and
+// an inactive 128^3 tile of `b` (the background); `narrow` keeps it all in
+// one 4096^3 node and 54 leaves (x 0..69, y 0..28, z 0..13: 24 x 3 x 2
+// voxels, and the small tile) for the uncompressed file, where each node
+// and leaf stores all its values. Active voxels: 6 062, or 656 when narrow
+// (tests/test_vdb_trees.c).
+template <typename G>
+typename G::Ptr typed_grid(const char* name, typename G::ValueType a, typename G::ValueType b, bool narrow)
+{
+    typename G::Ptr g = G::create(b);
+    g->setName(name);
+    typename G::Accessor acc = g->getAccessor();
+    for (int i = narrow ? 0 : -40; i < 70; i += 3)
+        for (int j = 0; j < (narrow ? 3 : 15); ++j)
+            for (int k = 0; k < (narrow ? 2 : 10); ++k) acc.setValue(Coord(i, j * 14, k * 13), a);
+    g->tree().addTile(1, Coord(256, 0, 0), a, true);
+    if (!narrow) g->tree().addTile(2, Coord(8192, 0, 0), b, false);
+    return g;
+}
+
+// Every grid type of tree_files(), and a level set (negative inactive
+// values: the mask-compression cases that store inactive values) and an
+// instance of the float grid.
+openvdb::GridPtrVec typed_grids(bool narrow, bool half)
+{
+    using namespace openvdb;
+    GridPtrVec v = {typed_grid<FloatGrid>("float", 1.5f, 0.25f, narrow),
+                    typed_grid<DoubleGrid>("double", 2.5, -1.0, narrow),
+                    typed_grid<Int32Grid>("int32", 7, 3, narrow),
+                    typed_grid<Int64Grid>("int64", 9, 2, narrow),
+                    typed_grid<Vec3SGrid>("vec3s", Vec3s(1, 2, 3), Vec3s(0.5f), narrow),
+                    typed_grid<Vec3DGrid>("vec3d", Vec3d(1, 2, 3), Vec3d(-1), narrow),
+                    typed_grid<Vec3IGrid>("vec3i", Vec3i(1, 2, 3), Vec3i(4), narrow),
+                    typed_grid<BoolGrid>("bool", true, false, narrow)};
+    FloatGrid::Ptr ls = openvdb::tools::createLevelSetSphere<FloatGrid>(10.0f, openvdb::Vec3f(0.0f), 1.0f, 3.0f);
+    ls->setName("level_set");
+    v.push_back(ls);
+    GridBase::Ptr inst = v[0]->copyGrid(); // shares the float grid's tree: written as an instance
+    inst->setName("instance");
+    v.push_back(inst);
+    for (auto& g : v) g->setSaveFloatAsHalf(half);
+    return v;
+}
+
+std::vector<char> read_bytes(const std::string& p)
+{
+    std::ifstream in(p, std::ios::binary);
+    return std::vector<char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+void write_bytes(const std::string& p, const std::vector<char>& b)
+{
+    std::ofstream out(p, std::ios::binary);
+    out.write(b.data(), (std::streamsize)b.size());
+    if (!out) throw std::runtime_error("cannot write " + p);
+}
+
+uint32_t le32(const char* p)
+{
+    uint32_t v;
+    std::memcpy(&v, p, 4);
+    return v;
+}
+
+// The one offset in b where match(b, offset) holds (the patterns below are
+// chosen unique in their small files; not unique is an error, not a guess).
+template <typename M>
+size_t find_one(const std::vector<char>& b, const char* what, M match)
+{
+    size_t at = SIZE_MAX;
+    for (size_t i = 0; i + 32 <= b.size(); ++i)
+        if (match(b, i)) {
+            if (at != SIZE_MAX) throw std::runtime_error(std::string("more than one ") + what);
+            at = i;
+        }
+    if (at == SIZE_MAX) throw std::runtime_error(std::string("no ") + what);
+    return at;
+}
+
+// The tree files: the typed grids under each compression (zip and blosc
+// with OpenVDB's active-mask compression, as OpenVDB writes by default),
+// and four files made from a one-leaf float grid (512 values i/7, blosc)
+// by changing one claim of its tree, each of which OpenVDB took as given:
+//   chunk_big.vdb     the leaf's blosc chunk claims 10^10 bytes (allocated
+//                     before reading: 10 GB)
+//   chunk_raw.vdb     a leaf of 4 active values (16 bytes, in a 32-byte blosc
+//                     chunk) claims instead 4096 bytes stored raw (size
+//                     -4096: read into its 16-byte buffer, a heap overflow)
+//   chunk_header.vdb  the blosc header inside the chunk claims 2^30 bytes
+//                     uncompressed where the leaf holds 2 048
+//   root_count.vdb    the root claims 2^31 children (each a 32^3 node of
+//                     256 KB, allocated as the reading goes on)
+void tree_files()
+{
+    using openvdb::io::COMPRESS_ACTIVE_MASK;
+    using openvdb::io::COMPRESS_BLOSC;
+    using openvdb::io::COMPRESS_NONE;
+    using openvdb::io::COMPRESS_ZIP;
+    const struct {
+        const char* name;
+        uint32_t compression;
+        bool half, narrow;
+    } files[] = {{"types_blosc.vdb", COMPRESS_BLOSC | COMPRESS_ACTIVE_MASK, false, false},
+                 {"types_zip.vdb", COMPRESS_ZIP | COMPRESS_ACTIVE_MASK, false, false},
+                 {"types_raw.vdb", COMPRESS_NONE, false, true},
+                 {"types_half.vdb", COMPRESS_BLOSC | COMPRESS_ACTIVE_MASK, true, false}};
+    for (const auto& f : files) {
+        openvdb::io::File file(path(f.name));
+        file.setGridStatsMetadataEnabled(false);
+        file.setCompression(f.compression);
+        file.write(typed_grids(f.narrow, f.half));
+        file.close();
+    }
+
+    auto one_leaf = [](const char* name, int active) {
+        FloatGrid::Ptr g = float_grid("density", 0.1);
+        FloatGrid::Accessor acc = g->getAccessor();
+        for (int n = 0; n < active; ++n) acc.setValue(Coord(n & 7, (n >> 3) & 7, n >> 6), 1.0f + (float)n / 7.0f);
+        openvdb::io::File file(path(name));
+        file.setCompression(COMPRESS_BLOSC | COMPRESS_ACTIVE_MASK);
+        file.write({g});
+        file.close();
+        return read_bytes(path(name));
+    };
+    // a blosc chunk of the leaf: int64 size n > 0, then blosc's header
+    // (uint32 uncompressed bytes at +4, compressed bytes at +12 = n)
+    auto blosc_chunk = [](const std::vector<char>& b, size_t i) {
+        int64_t n;
+        std::memcpy(&n, &b[i], 8);
+        return n > 16 && n < 100000 && le32(&b[i + 12]) == 2048 && le32(&b[i + 20]) == (uint32_t)n;
+    };
+    std::vector<char> b = one_leaf("chunk_big.vdb", 512);
+    size_t at = find_one(b, "blosc chunk", blosc_chunk);
+    const int64_t huge = 10000000000;
+    std::memcpy(&b[at], &huge, 8);
+    write_bytes(path("chunk_big.vdb"), b);
+
+    b = one_leaf("chunk_header.vdb", 512);
+    at = find_one(b, "blosc chunk", blosc_chunk);
+    const uint32_t claim = 1u << 30;
+    std::memcpy(&b[at + 12], &claim, 4);
+    write_bytes(path("chunk_header.vdb"), b);
+
+    b = one_leaf("root_count.vdb", 512);
+    // the root: int32 buffer count 1, background 0.0f, 0 tiles, 1 child
+    const char root[16] = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0};
+    at = find_one(b, "root", [&](const std::vector<char>& v, size_t i) { return std::memcmp(&v[i], root, 16) == 0; });
+    const uint32_t children = 1u << 31;
+    std::memcpy(&b[at + 12], &children, 4);
+    write_bytes(path("root_count.vdb"), b);
+
+    b = one_leaf("chunk_raw.vdb", 4);
+    // the leaf's 16 bytes of values in a 32-byte blosc chunk: int64 32,
+    // then blosc's header (16 bytes uncompressed, 32 compressed)
+    at = find_one(b, "small chunk", [&](const std::vector<char>& v, size_t i) {
+        int64_t n;
+        std::memcpy(&n, &v[i], 8);
+        return n == 32 && le32(&v[i + 12]) == 16 && le32(&v[i + 20]) == 32;
+    });
+    const int64_t more = -4096;
+    std::memcpy(&b[at], &more, 8);
+    write_bytes(path("chunk_raw.vdb"), b);
 }
 
 } // namespace

@@ -48,6 +48,16 @@ foreach(case native nanovdb filters)
   set_tests_properties(vdb_${case} PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "unit;accuracy")
 endforeach()
 
+# Trees checked before OpenVDB reads them (tests/test_vdb_trees.c): every
+# grid type under every compression reads; absurd claims inside a tree are
+# refused by the check.
+add_executable(test_vdb_trees ${CMAKE_CURRENT_SOURCE_DIR}/test_vdb_trees.c ${CMAKE_CURRENT_SOURCE_DIR}/check.c)
+target_link_libraries(test_vdb_trees PRIVATE veil veil_fp veil_warnings)
+foreach(case types corrupt)
+  add_test(NAME vdb_trees_${case} COMMAND test_vdb_trees ${VDB_DATA} ${case})
+  set_tests_properties(vdb_trees_${case} PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "unit;bad_input")
+endforeach()
+
 # Truncated files fail fast and small, naming the file (tests/vdb_truncated.sh).
 add_test(NAME vdb_truncated COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/vdb_truncated.sh $<TARGET_FILE:veil_cli>
                                    ${VDB_DATA}/fog_sphere.vdb)
