@@ -447,9 +447,10 @@ typedef struct read_request {
 typedef struct read_target {
     int n;
     const char* const* names;
-    float* pixels; /* width*height*n */
+    float* pixels; /* width*height*n; NULL: the chunks are only checked (below) */
     int width, height;
     int min_x, min_y; /* data window origin */
+    uint64_t file_size;
 } read_target;
 
 /* Decodes one chunk whose top-left pixel is (x0, y0) relative to the data
@@ -461,6 +462,12 @@ static exr_result_t decode_chunk(exr_const_context_t ctx, const exr_chunk_info_t
     if (x0 < 0 || y0 < 0 || ci->width <= 0 || ci->height <= 0 || (int64_t)x0 + ci->width > t->width ||
         (int64_t)y0 + ci->height > t->height)
         return EXR_ERR_INCORRECT_CHUNK;
+    /* Before the image is allocated, every chunk is found in the file: a
+     * header may claim 16384^2 pixels in a file of a few bytes. */
+    if (!t->pixels)
+        return ci->data_offset <= t->file_size && ci->packed_size <= t->file_size - ci->data_offset
+                   ? EXR_ERR_SUCCESS
+                   : EXR_ERR_BAD_CHUNK_LEADER;
     rv = *pipeline_ready ? exr_decoding_update(ctx, 0, ci, dec) : exr_decoding_initialize(ctx, 0, ci, dec);
     if (rv != EXR_ERR_SUCCESS) return rv;
     *pipeline_ready = 1;
@@ -555,8 +562,9 @@ static void list_append(char* buf, size_t cap, const char* item)
     snprintf(buf + at, cap - at, "%s...", at ? ", " : "");
 }
 
-static veil_result read_channels(exr_const_context_t ctx, const char* path, const read_request* req, int* width,
-                                 int* height, float** out, exr_msgs* msgs, veil_error* err)
+static veil_result read_channels(exr_const_context_t ctx, const char* path, uint64_t file_size,
+                                 const read_request* req, int* width, int* height, float** out, exr_msgs* msgs,
+                                 veil_error* err)
 {
     int parts = 0;
     exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
@@ -584,8 +592,8 @@ static veil_result read_channels(exr_const_context_t ctx, const char* path, cons
                          dw.min.y, dw.max.x, dw.max.y);
     /* a bound on what an untrusted header can make us allocate before any pixel is read */
     if ((uint64_t)w * (uint64_t)h > VEIL_EXR_MAX_PIXELS)
-        return veil_fail(err, VEIL_ERR_LIMIT, "%s: OpenEXR image %" PRId64 "x%" PRId64 " has more than 2^26 pixels (an "
-                         "8192x8192 image), the most veil reads", path, w, h);
+        return veil_fail(err, VEIL_ERR_LIMIT, "%s: OpenEXR image %" PRId64 "x%" PRId64 " has more than 2^28 pixels (a "
+                         "16384x16384 image, the largest veil renders), the most veil reads", path, w, h);
     size_t bytes = 0;
     if (!veil_mul_sizes((size_t)w, (size_t)h, (size_t)n, sizeof(float), &bytes) ||
         (uint64_t)w > (uint64_t)INT32_MAX / ((size_t)n * sizeof(float)))
@@ -618,6 +626,11 @@ static veil_result read_channels(exr_const_context_t ctx, const char* path, cons
                          nmissing > 1 ? "s" : "", missing, req->missing_note, have[0] ? have : "none");
     }
 
+    /* each chunk of the image is where the chunk table says, inside the file, before the image is allocated */
+    read_target t = {n, req->names, NULL, (int)w, (int)h, dw.min.x, dw.min.y, file_size};
+    veil_result r = read_pixels(ctx, path, storage, &t, msgs, err);
+    if (r != VEIL_OK) return r;
+
     float* pixels = calloc(bytes / sizeof(float), sizeof(float));
     if (!pixels)
         return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory for a %" PRId64 "x%" PRId64 " image", path, w, h);
@@ -625,8 +638,8 @@ static veil_result read_channels(exr_const_context_t ctx, const char* path, cons
         for (size_t i = 0, count = (size_t)w * (size_t)h; i < count; ++i)
             pixels[i * (size_t)n + (size_t)req->optional] = 1.0f;
 
-    read_target t = {n, req->names, pixels, (int)w, (int)h, dw.min.x, dw.min.y};
-    veil_result r = read_pixels(ctx, path, storage, &t, msgs, err);
+    t.pixels = pixels;
+    r = read_pixels(ctx, path, storage, &t, msgs, err);
     if (r != VEIL_OK) {
         free(pixels);
         return r;
@@ -682,7 +695,7 @@ static veil_result read_exr_file(const char* fn, const char* path, const read_re
         r = veil_fail(err, VEIL_ERR_IO, "%s: not a readable OpenEXR file: %s [%s]", path, exr_reason(&msgs, rv),
                       exr_get_error_code_as_string(rv));
     } else {
-        r = read_channels(ctx, path, req, width, height, out, &msgs, err);
+        r = read_channels(ctx, path, (uint64_t)st.st_size, req, width, height, out, &msgs, err);
     }
     if (ctx) exr_finish(&ctx);
     tls_msgs = saved;

@@ -32,10 +32,12 @@ veil_result veil_write_exr_planes(const char* path, int width, int height, int n
 veil_result veil_read_exr_channel(const char* path, const char* name, int* width, int* height, float** plane,
                                   veil_error* err);
 
-/* At most this many pixels are read from an EXR (its header says how many
- * before any pixel is decoded: an untrusted file must not make veil
- * allocate gigabytes): 2^26, an 8192 x 8192 image, 1 GiB as RGBA float. */
-#define VEIL_EXR_MAX_PIXELS ((uint64_t)1 << 26)
+/* At most this many pixels are read from an EXR: 2^28, a 16384 x 16384
+ * image (the largest veil renders), 4 GiB as RGBA float. An untrusted
+ * header must not make veil allocate that for nothing: the image is
+ * allocated only once every chunk the header implies has been found in
+ * the file (the chunk table's offsets and the chunks' sizes inside it). */
+#define VEIL_EXR_MAX_PIXELS ((uint64_t)1 << 28)
 
 /* Reads an EXR's R, G, B, A channels (A = 1 when absent) as float into a
  * newly malloc'd buffer *rgba (free() it). Any scanline or tiled EXR that
