@@ -28,6 +28,7 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "progress.h"
 #include "frame/renderer.h"
 #include "gpu/gl_context.h"
 #include "io/image.h"
@@ -158,7 +159,9 @@ int veil_cmd_fog(int argc, char** argv)
     if (r == VEIL_OK) r = veil_renderer_create(gl, &ren, &err);
     if (r == VEIL_OK) {
         veil_render_opts opts = {.behind = frame, .behind_distance = depth};
+        veil_cli_progress_begin(NULL);
         r = veil_render_scene_images(ren, &scene, &opts, &im, &st, &err);
+        veil_cli_progress_end();
         if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
     }
     /* all or nothing: both staged, then renamed over the targets (cli/cli_util.h) */

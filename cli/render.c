@@ -8,6 +8,7 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "progress.h"
 #include "core/clock.h"
 #include "frame/plan.h"
 #include "frame/renderer.h"
@@ -122,7 +123,11 @@ int veil_cmd_render(int argc, char** argv)
         veil_render_opts opts = {.width = (int)a.width, .height = (int)a.height, .step_voxels = a.step,
                                  .seed = (uint32_t)a.seed, .method = a.method, .camera = &cam};
         veil_render_stats st = {0};
+        char label[64] = "";
+        if (frames > 1) snprintf(label, sizeof label, "frame %ld/%ld", f + 1, frames);
+        veil_cli_progress_begin(label);
         r = veil_render_scene_images(ren, &scene, &opts, &im, &st, &err);
+        veil_cli_progress_end();
         if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
         char exr[4096], png[4096];
         if (r == VEIL_OK) r = veil_frame_path(a.exr, f, a.frames > 0, exr, sizeof exr, &err);

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "../core/clock.h"
+#include "../core/progress.h"
 #include "../core/hash.h"
 #include "../propagate/opv_set.h"
 #include "../render/diffusion.h"
@@ -377,6 +378,7 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
     st->particles = r->particles;
     st->width = o->width, st->height = o->height;
     double t0 = veil_now_ms();
+    veil_progress("propagate", 0, 1);
     veil_result res = propagate(r, s, lights, n, o, st, err);
     glFinish();
     double t1 = veil_now_ms();
@@ -394,12 +396,14 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
                           .no_background = o->behind != NULL};
     veil_diffusion_field field = {0};
     double t2 = veil_now_ms();
+    veil_progress("multiple scattering", 0, 1);
     res = diffuse(r, s, &md, &field, st, err);
     glFinish();
     st->stage[VEIL_STAGE_VOLUMETRIC].ms = veil_now_ms() - t2;
     if (res != VEIL_OK) return res;
     md.diffusion = &field;
     t1 = veil_now_ms();
+    veil_progress("march", 0, 1);
     res = veil_march_run(r->march, &md, images, err);
     if (res == VEIL_OK && o->behind) { /* what is behind, attenuated: T L */
         size_t pixels = (size_t)images->width * (size_t)images->height;
@@ -415,7 +419,10 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
         !ms->volumetric ? ""
         : ms->volumetric_method == VEIL_VOLUMETRIC_DIFFUSION ? ", multiple scattering from the diffusion field"
         : ms->octaves > 1 ? ", volumetric multiple scattering (octaves)" : "");
-    if (res == VEIL_OK) res = spread(r, s, o, images, st, err);
+    if (res == VEIL_OK) {
+        veil_progress("spread", 0, 1);
+        res = spread(r, s, o, images, st, err);
+    }
     return res;
 }
 
@@ -435,6 +442,7 @@ veil_result veil_render_scene_images(veil_renderer* r, const veil_scene* s, cons
     memset(&st, 0, sizeof st);
     veil_image_set_free(images);
     double t0 = veil_now_ms();
+    veil_progress("inject", 0, 1);
     veil_result res = inject_scene(r, s, &st, err);
     glFinish();
     st.stage[VEIL_STAGE_INJECT].ms = veil_now_ms() - t0;

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "../core/hash.h"
+#include "../core/progress.h"
 #include "../gpu/gl_util.h"
 #include "../gpu/programs.h"
 #include "opv_gpu.h"
@@ -194,7 +195,12 @@ veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, 
 {
     memset(rep, 0, sizeof *rep);
     veil_result r = VEIL_OK;
+    const int report = veil_progress_wanted();
     for (int t = 0; 4 * t < n && r == VEIL_OK; ++t) {
+        if (report) { /* lights done of all; the textures before this one finished first */
+            glFinish();
+            veil_progress("optical depth, lights", 4.0 * t, n);
+        }
         int count = n - 4 * t < 4 ? n - 4 * t : 4;
         veil_opv_light ol[4];
         for (int c = 0; c < count; ++c) veil_opv_light_from_world(g, &lights[4 * t + c], &ol[c]);
@@ -211,6 +217,10 @@ veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, 
         if (r == VEIL_OK) s->key[t] = key;
         rep->iterations = it > rep->iterations ? it : rep->iterations;
         ++rep->computed;
+    }
+    if (report && r == VEIL_OK) {
+        glFinish();
+        veil_progress("optical depth, lights", n, n);
     }
     return r;
 }

@@ -18,6 +18,11 @@ add_test(NAME cli_output_paths
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/output_paths.sh $<TARGET_FILE:veil_cli>
           ${PROJECT_SOURCE_DIR}/data/scenes/height_fog.json)
 set_tests_properties(cli_output_paths PROPERTIES LABELS "gpu;cli;bad_input" SKIP_RETURN_CODE 77)
+# A status line on a terminal for the work under way, none in a pipe (tests/progress_tty.sh).
+add_test(NAME cli_progress_tty
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/progress_tty.sh $<TARGET_FILE:veil_cli>
+          ${PROJECT_SOURCE_DIR}/data/scenes/rbf_fog.json)
+set_tests_properties(cli_progress_tty PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)
 veil_test(test_render_cache SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_render_cache.c LABELS gpu)
 # The marcher against closed forms (airlight, a Gaussian's erf, slanted
 # exponential fog) within step-error bounds derived in the test.

@@ -1,5 +1,6 @@
 #include "inject_gpu.h"
 
+#include "../core/progress.h"
 #include "../gpu/gl_util.h"
 
 veil_result veil_inject_rbf_gpu(GLuint program, const veil_grid* g, const veil_rbf_bins* b,
@@ -25,6 +26,10 @@ veil_result veil_inject_rbf_gpu(GLuint program, const veil_grid* g, const veil_r
          * layer alone is under it whenever the whole splat is under VEIL_SPLAT_MAX_EVALS) */
         GLint first_z = glGetUniformLocation(program, "u_first_z");
         size_t layer = (size_t)b->bricks[0] * (size_t)b->bricks[1];
+        const double all = (double)b->list_len * VEIL_BRICK * VEIL_BRICK * VEIL_BRICK;
+        double done = 0.0;
+        const int report = veil_progress_wanted();
+        if (report) veil_progress("RBF splat", 0.0, all);
         int z = 0;
         while (z < b->bricks[2]) {
             int z1 = z;
@@ -42,6 +47,11 @@ veil_result veil_inject_rbf_gpu(GLuint program, const veil_grid* g, const veil_r
                             GL_TEXTURE_UPDATE_BARRIER_BIT);
             glFlush();
             z = z1;
+            done += (double)work;
+            if (report) { /* what is reported is done: the dispatch is finished first */
+                glFinish();
+                veil_progress("RBF splat", done, all);
+            }
         }
         for (GLuint i = 0; i < 3; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_PARTICLES + i, 0);
         glBindImageTexture(VEIL_IMAGE_EV, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);

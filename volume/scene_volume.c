@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include "../core/hash.h"
+#include "../core/progress.h"
 #include "blackbody.h"
 #include "sparse.h"
 #include "vdb_volume.h"
@@ -72,6 +73,12 @@ static veil_result open_vdb(veil_scene_volume* v, const veil_source* src, size_t
     char chosen[256];
     veil_vdb* vdb = NULL;
     veil_error inner = {{0}};
+    if (veil_progress_wanted()) {
+        const char* base = strrchr(src->vdb.file, '/');
+        char what[160];
+        snprintf(what, sizeof what, "reading %.140s", base ? base + 1 : src->vdb.file);
+        veil_progress(what, 0, 1);
+    }
     veil_result r = veil_vdb_open(src->vdb.file, src->vdb.grid, src->vdb.level_set_to_fog, &vdb, chosen,
                                   sizeof chosen, &inner);
     if (r != VEIL_OK) return veil_fail(err, r, "medium.sources[%zu]: %.1900s", i, inner.msg);

@@ -1,0 +1,20 @@
+/* veil — the progress of long work, for whoever shows it (the CLI, on a
+ * terminal). The pipeline says what it is doing: a stage begins ("inject",
+ * done 0 of 1), a measured part of it is done ("RBF splat", evaluations
+ * done of all). A sink installed on a thread receives the calls that
+ * thread makes; with none, a call costs a test of a thread-local pointer.
+ * Work that runs on the GPU is made to finish before it is reported when
+ * veil_progress_wanted() (a report of submitted work would say nothing). */
+#ifndef VEIL_PROGRESS_H
+#define VEIL_PROGRESS_H
+
+/* what: a short phrase, valid only during the call; 0 <= done <= total. */
+typedef void (*veil_progress_fn)(void* user, const char* what, double done, double total);
+
+/* Installs fn (NULL: none) for the calling thread; returns the one it replaces. */
+veil_progress_fn veil_progress_sink(veil_progress_fn fn, void* user, void** old_user);
+
+int veil_progress_wanted(void);
+void veil_progress(const char* what, double done, double total);
+
+#endif
