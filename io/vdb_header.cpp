@@ -22,7 +22,8 @@ namespace {
 // truncation of a 2.5 MB file: 7.6 GB and over 20 s) before failing. The
 // layout walked here (little-endian, file versions 222 and later):
 //   int64 magic 0x56444220; uint32 file version; uint32 library major and
-//   minor; char "has grid offsets"; 36 chars UUID; the file's metadata:
+//   minor; char "has grid offsets" (1: the files io::File writes; 0, a
+//   stream's, is refused); 36 chars UUID; the file's metadata:
 //   uint32 count, then per entry a name and a type (uint32 length + chars
 //   each) and a value (uint32 size + bytes); then, with grid offsets, int32
 //   grid count and per grid its unique name, type and instance parent
@@ -60,7 +61,9 @@ public:
         bool offsets = bytes(1, "the grid-offsets flag")[0] != 0;
         skip(36, "the UUID");
         metadata("the file's", size_);
-        if (!offsets) return true;
+        if (!offsets) // OpenVDB's io::Stream writes these; io::File then reads every grid whole, unchecked
+            throw std::string("an OpenVDB file without grid offsets (written by a stream, not io::File): veil reads "
+                              "files with them; write it again with a current OpenVDB (vdb_tool -read -write)");
         int32_t count = (int32_t)u32();
         if (count < 0 || (uint64_t)count * 36 > left()) bad("the grid count", (uint64_t)(uint32_t)count);
         for (int32_t i = 0; i < count; ++i) {
@@ -87,21 +90,24 @@ public:
 
     // Walks the tree of every grid whose name (the unique name up to
     // OpenVDB's suffix separator, ASCII 0x1e) is `name`, and of the grids
-    // they are instances of.
+    // they are instances of; of every grid when there is none, or an
+    // instance's parent is not found (OpenVDB's lookup may differ).
     void trees(const std::string& name)
     {
         std::vector<const grid*> todo;
         for (const grid& g : grids_)
             if (g.name.substr(0, g.name.find('\x1e')) == name) todo.push_back(&g);
-        for (size_t k = 0; k < todo.size() && k <= grids_.size(); ++k) {
+        bool all = todo.empty(); // OpenVDB may find what this does not: then every tree is walked
+        for (size_t k = 0; k < todo.size() && !all; ++k) {
             const grid& g = *todo[k];
-            if (g.parent.empty()) {
-                tree(g);
-                continue;
-            }
+            if (g.parent.empty()) continue;
+            bool found = false;
             for (const grid& p : grids_)
-                if (p.name == g.parent) todo.push_back(&p);
+                if (p.name == g.parent && k < grids_.size()) todo.push_back(&p), found = true;
+            all = !found;
         }
+        for (const grid& g : grids_)
+            if (g.parent.empty() && (all || std::find(todo.begin(), todo.end(), &g) != todo.end())) tree(g);
     }
 
 private:
@@ -109,6 +115,7 @@ private:
         std::string name, type, parent;
         uint64_t grid = 0, topology = 0, block = 0, end = 0;
         uint32_t compression = 0;
+        int half = -1; // its is_saved_as_half_float metadata: -1 none, 0 or 1 a bool's value, 2 another type
     };
 
     // OpenVDB's compression flags (io/Compression.h) and the metadata byte
@@ -124,7 +131,7 @@ private:
     // takes later bytes for string lengths); a "__delayedload" value is
     // checked as delayed_load() says. `span`: the bytes of the grid (the
     // file's, for the file's metadata).
-    void metadata(const char* whose, uint64_t span)
+    void metadata(const char* whose, uint64_t span, int* half = nullptr)
     {
         static const std::pair<const char*, uint32_t> fixed[] = {
             {"bool", 1},   {"int32", 4},  {"int64", 8},   {"float", 4},  {"double", 8}, {"vec2i", 8},
@@ -134,10 +141,11 @@ private:
         uint32_t entries = u32();
         if ((uint64_t)entries * 12 > left()) bad((what + " count").c_str(), entries);
         for (uint32_t e = 0; e < entries; ++e) {
-            string((what + " name").c_str());
+            const std::string name = string((what + " name").c_str());
             std::string type = string((what + " type").c_str());
             uint32_t value = u32();
             if (value > left()) bad((what + " value").c_str(), value);
+            const bool half_entry = half && name == "is_saved_as_half_float"; // see tree()
             for (const auto& f : fixed)
                 if (type == f.first && value != f.second) {
                     char msg[300];
@@ -146,7 +154,10 @@ private:
                                   (unsigned long long)at_);
                     throw std::string(msg);
                 }
-            if (type == "__delayedload" && value > 0) {
+            if (half_entry) *half = 2;
+            if (half_entry && type == "bool") { // its one byte (checked above)
+                *half = bytes(1, "a bool")[0] != 0;
+            } else if (type == "__delayedload" && value > 0) {
                 delayed_load(value, span);
             } else {
                 skip(value, what.c_str());
@@ -196,7 +207,7 @@ private:
     {
         limit within(*this, g.grid, g.block); // nothing of the header may reach past its block
         g.compression = u32();
-        metadata("a grid's", g.end - g.grid);
+        metadata("a grid's", g.end - g.grid, &g.half);
         map(string("a grid's transform type"), true);
         g.topology = at_;
     }
@@ -241,12 +252,23 @@ private:
     // origin and a 64-byte mask of values).
     void tree(const grid& g)
     {
+        // Stored as half: OpenVDB reads the tree as its metadata says (a
+        // bool named is_saved_as_half_float), which the type's suffix
+        // repeats; a file where they differ, or where the bool is missing or
+        // of another type, is not one the walk can follow as OpenVDB will.
         std::string t = g.type;
         bool half = false;
         const std::string hs = "_HalfFloat";
         if (t.size() > hs.size() && t.compare(t.size() - hs.size(), hs.size(), hs) == 0) {
             half = true;
             t.resize(t.size() - hs.size());
+        }
+        if (g.half == 2 || (g.half == -1 && half) || (g.half >= 0 && g.half <= 1 && (g.half == 1) != half)) {
+            static const char* const says[] = {"false", "true", "of another type than bool"};
+            std::string msg = "corrupt OpenVDB file: grid '" + g.name.substr(0, g.name.find('\x1e')) + "' has the "
+                              "type " + g.type + " but its metadata is_saved_as_half_float is " +
+                              (g.half < 0 ? "missing" : says[g.half]);
+            throw msg;
         }
         static const struct {
             const char* type;

@@ -12,7 +12,8 @@
 
 // true when nothing is amiss (or the file is not OpenVDB's: OpenVDB then
 // says so itself); false with *why ("truncated or corrupt OpenVDB file:
-// ..."). Files older than version 222 (OpenVDB 2.0) are refused.
+// ..."). Files older than version 222 (OpenVDB 2.0) and files without
+// grid offsets (written by io::Stream) are refused.
 bool veil__vdb_header_ok(const std::string& path, std::string* why);
 
 // The same, and the tree of every grid named `grid` (the name as OpenVDB's

@@ -21,7 +21,7 @@ seeds=$build/fuzz-seeds
 mkdir -p "$seeds"/{vdb,exr,particles} "$build/crashes"
 "$build/tests/make_test_vdbs" "$seeds/vdb.tmp" >/dev/null || exit 1
 for f in offset_scaled.vdb offset_scaled.nvdb offset_scaled_half.vdb two_grids.vdb emissive_slab.vdb empty.vdb \
-    chunk_big.vdb chunk_raw.vdb chunk_header.vdb root_count.vdb; do
+    chunk_big.vdb chunk_raw.vdb chunk_header.vdb root_count.vdb no_offsets.vdb; do
     cp "$seeds/vdb.tmp/$f" "$seeds/vdb/" 2>/dev/null
 done
 rm -rf "$seeds/vdb.tmp"

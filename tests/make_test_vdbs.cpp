@@ -34,7 +34,8 @@
 //                        a grid of each value type OpenVDB registers for voxels, a level
 //                        set and an instance, under each compression, without stats
 //                        metadata (so reading the file's statistics reads every tree)
-//   chunk_big.vdb, chunk_raw.vdb, chunk_header.vdb, root_count.vdb: one small grid each,
+//   chunk_big.vdb, chunk_raw.vdb, chunk_header.vdb, root_count.vdb, no_offsets.vdb,
+//   half_mismatch.vdb: one small grid each,
 //                        with one claim of its tree made absurd (tree_files below)
 //
 // The values that tests/test_vdb.c recomputes (the linear field, the two
@@ -412,6 +413,10 @@ size_t find_one(const std::vector<char>& b, const char* what, M match)
 //                     uncompressed where the leaf holds 2 048
 //   root_count.vdb    the root claims 2^31 children (each a 32^3 node of
 //                     256 KB, allocated as the reading goes on)
+//   no_offsets.vdb    says it has no grid offsets (as io::Stream writes):
+//                     io::File then reads each grid whole as it comes
+//   half_mismatch.vdb a grid stored as half whose is_saved_as_half_float
+//                     metadata says false: OpenVDB reads its tree as floats
 void tree_files()
 {
     using openvdb::io::COMPRESS_ACTIVE_MASK;
@@ -470,6 +475,26 @@ void tree_files()
     const uint32_t children = 1u << 31;
     std::memcpy(&b[at + 12], &children, 4);
     write_bytes(path("root_count.vdb"), b);
+
+    { // the leaf stored as half, its is_saved_as_half_float bool turned false
+        FloatGrid::Ptr g = float_grid("density", 0.1);
+        g->tree().setValue(Coord(1, 2, 3), 0.5f);
+        g->setSaveFloatAsHalf(true);
+        write("half_mismatch.vdb", {g});
+        b = read_bytes(path("half_mismatch.vdb"));
+        const std::string key = "is_saved_as_half_float";
+        at = find_one(b, "half-float flag", [&](const std::vector<char>& v, size_t i) {
+            return std::memcmp(&v[i], key.data(), key.size()) == 0 && le32(&v[i + key.size()]) == 4 &&
+                   std::memcmp(&v[i + key.size() + 4], "bool", 4) == 0 && le32(&v[i + key.size() + 8]) == 1 &&
+                   v[i + key.size() + 12] == 1;
+        });
+        b[at + key.size() + 12] = 0;
+        write_bytes(path("half_mismatch.vdb"), b);
+    }
+
+    b = one_leaf("no_offsets.vdb", 512);
+    b[20] = 0; // after the magic, the file version and the library version: "has grid offsets"
+    write_bytes(path("no_offsets.vdb"), b);
 
     b = one_leaf("chunk_raw.vdb", 4);
     // the leaf's 16 bytes of values in a 32-byte blosc chunk: int64 32,
