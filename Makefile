@@ -69,7 +69,7 @@ fuzz:
 	@bash scripts/install-bench-deps.sh clang
 	@CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVEIL_FUZZ=ON \
 	  -DVEIL_SANITIZE=ON >/dev/null
-	@cmake --build build-fuzz -j $(JOBS) --target fuzz_scene fuzz_particles fuzz_exr fuzz_vdb make_test_vdbs \
+	@cmake --build build-fuzz -j $(JOBS) --target fuzz_scene fuzz_particles fuzz_exr fuzz_vdb fuzz_nanovdb make_test_vdbs \
 	  make_compare_exrs veil_cli -- --no-print-directory
 	@bash scripts/fuzz.sh build-fuzz $(FUZZ_SECONDS)
 

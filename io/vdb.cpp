@@ -14,6 +14,7 @@
 #include <openvdb/tools/LevelSetUtil.h>
 #include <nanovdb/util/IO.h>
 #include <nanovdb/util/NanoToOpenVDB.h>
+#include "nanovdb_check.hpp"
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -213,28 +214,62 @@ bool is_nanovdb(const std::string& path)
 // of its decoded values), named and classed as in the file. A grid of a
 // type the converter does not know (points, indices) is left out. The
 // grids are complete: the callers treat them as read.
+// A grid of NanoVDB build type T, its nodes checked first (io/nanovdb_check.hpp).
+template <typename T>
+GridBase::Ptr nano_to_openvdb(const nanovdb::GridHandle<nanovdb::HostBuffer>& h)
+{
+    const auto& grid = *reinterpret_cast<const nanovdb::NanoGrid<T>*>(h.data());
+    veil_nano::grid_ok(grid, h.size());
+    return nanovdb::nanoToOpenVDB(grid);
+}
+
 openvdb::GridPtrVec read_nanovdb(const std::string& path)
 {
     init_openvdb();
     check_readable(path);
     std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> handles;
     try {
+        veil_nano::file_ok(path);
         handles = nanovdb::io::readGrids(path);
+    } catch (const std::string& why) {
+        fail_with(VEIL_ERR_IO, path + ": " + why);
     } catch (const std::exception& e) {
         fail_with(VEIL_ERR_IO, path + ": cannot read the NanoVDB file: " + e.what());
     }
     if (handles.empty()) fail_with(VEIL_ERR_IO, path + ": cannot read the NanoVDB file: it holds no grid");
     openvdb::GridPtrVec out;
     for (const auto& h : handles) {
-        const nanovdb::GridMetaData* m = h.gridMetaData();
-        if (!m) continue;
+        if (h.size() < sizeof(nanovdb::GridData)) continue; // file_ok: not from a file
+        const auto* d = reinterpret_cast<const nanovdb::GridData*>(h.data());
+        if (!std::memchr(d->mGridName, 0, sizeof d->mGridName))
+            fail_with(VEIL_ERR_IO, path + ": truncated or corrupt NanoVDB file: a grid name without its end");
         GridBase::Ptr g;
         try {
-            g = nanovdb::nanoToOpenVDB(h);
+            using nanovdb::GridType;
+            switch (d->mGridType) {
+            case GridType::Float: g = nano_to_openvdb<float>(h); break;
+            case GridType::Double: g = nano_to_openvdb<double>(h); break;
+            case GridType::Int32: g = nano_to_openvdb<int32_t>(h); break;
+            case GridType::Int64: g = nano_to_openvdb<int64_t>(h); break;
+            case GridType::Boolean: g = nano_to_openvdb<bool>(h); break;
+            case GridType::Mask: g = nano_to_openvdb<nanovdb::ValueMask>(h); break;
+            case GridType::Vec3f: g = nano_to_openvdb<nanovdb::Vec3f>(h); break;
+            case GridType::Vec3d: g = nano_to_openvdb<nanovdb::Vec3d>(h); break;
+            case GridType::Vec4f: g = nano_to_openvdb<nanovdb::Vec4f>(h); break;
+            case GridType::Vec4d: g = nano_to_openvdb<nanovdb::Vec4d>(h); break;
+            case GridType::Fp4: g = nano_to_openvdb<nanovdb::Fp4>(h); break;
+            case GridType::Fp8: g = nano_to_openvdb<nanovdb::Fp8>(h); break;
+            case GridType::Fp16: g = nano_to_openvdb<nanovdb::Fp16>(h); break;
+            case GridType::FpN: g = nano_to_openvdb<nanovdb::FpN>(h); break;
+            default: continue; // a type with no OpenVDB counterpart
+            }
+        } catch (const std::string& why) {
+            fail_with(VEIL_ERR_IO, path + ": grid '" + d->mGridName + "': " + why);
         } catch (const openvdb::RuntimeError&) {
             continue; // a type with no OpenVDB counterpart
         }
         if (!g) continue;
+        const nanovdb::GridMetaData* m = h.gridMetaData();
         g->setName(m->shortGridName());
         if (m->isLevelSet()) g->setGridClass(openvdb::GRID_LEVEL_SET);
         else if (m->isFogVolume()) g->setGridClass(openvdb::GRID_FOG_VOLUME);

@@ -27,6 +27,9 @@ run() { # expected-to-finish command...
 log=$(mktemp) || exit 1
 trap 'rm -f -- "$log"' EXIT
 for f in "$corpus"/vdb/*; do [ -f "$f" ] && run "$veil" info "$f"; done
+nvdb=$(mktemp --suffix=.nvdb) || exit 1 # NanoVDB is read by its name's suffix
+trap 'rm -f -- "$log" "$nvdb"' EXIT
+for f in "$corpus"/nanovdb/*; do [ -f "$f" ] && cp "$f" "$nvdb" && run "$veil" info "$nvdb"; done
 for f in "$corpus"/exr/*; do [ -f "$f" ] && run "$veil" compare "$f" "$f"; done
 for f in "$corpus"/scene/*; do [ -f "$f" ] && run "$veil" render "$f" --explain; done
 echo "$n corpus inputs, $fails failed"

@@ -35,7 +35,7 @@
 //                        set and an instance, under each compression, without stats
 //                        metadata (so reading the file's statistics reads every tree)
 //   chunk_big.vdb, chunk_raw.vdb, chunk_header.vdb, root_count.vdb, no_offsets.vdb,
-//   half_mismatch.vdb: one small grid each,
+//   half_mismatch.vdb, nano_size.nvdb, nano_child.nvdb: one small grid each,
 //                        with one claim of its tree made absurd (tree_files below)
 //
 // The values that tests/test_vdb.c recomputes (the linear field, the two
@@ -417,6 +417,8 @@ size_t find_one(const std::vector<char>& b, const char* what, M match)
 //                     io::File then reads each grid whole as it comes
 //   half_mismatch.vdb a grid stored as half whose is_saved_as_half_float
 //                     metadata says false: OpenVDB reads its tree as floats
+//   nano_size.nvdb    a NanoVDB grid described as 2^40 bytes (allocated before reading)
+//   nano_child.nvdb   a NanoVDB grid whose root points at its upper node 2^40 bytes away
 void tree_files()
 {
     using openvdb::io::COMPRESS_ACTIVE_MASK;
@@ -490,6 +492,22 @@ void tree_files()
         });
         b[at + key.size() + 12] = 0;
         write_bytes(path("half_mismatch.vdb"), b);
+    }
+
+    { // NanoVDB: a description claiming a 2^40-byte grid; a root tile's child 2^40 bytes away
+        FloatGrid::Ptr g = float_grid("density", 0.1);
+        g->tree().setValue(Coord(1, 2, 3), 0.5f);
+        auto handle = nanovdb::openToNanoVDB(*g);
+        nanovdb::io::writeGrid(path("nano_size.nvdb"), handle);
+        b = read_bytes(path("nano_size.nvdb"));
+        const uint64_t tib = 1ull << 40;
+        std::memcpy(&b[16], &tib, 8); // the first description's gridSize, after the 16-byte header
+        write_bytes(path("nano_size.nvdb"), b);
+        auto* grid = handle.grid<float>();
+        auto* nroot = grid->tree().root().data();
+        if (nroot->mTableSize < 1 || !nroot->tile(0)->isChild()) throw std::runtime_error("nano root: no child tile");
+        const_cast<nanovdb::NanoRoot<float>::DataType::Tile*>(nroot->tile(0))->child = (int64_t)1 << 40;
+        nanovdb::io::writeGrid(path("nano_child.nvdb"), handle);
     }
 
     b = one_leaf("no_offsets.vdb", 512);

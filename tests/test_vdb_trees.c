@@ -94,6 +94,10 @@ static void test_corrupt(void)
     /* OpenVDB reads a tree as half floats as the grid's metadata says, not
      * its type: where they differ, the walk could not follow it */
     refused("half_mismatch.vdb", "but its metadata is_saved_as_half_float is false");
+    /* NanoVDB allocated the described size before reading (1 TiB here) and
+     * followed a grid's child offsets as given (here 1 TiB past the buffer) */
+    refused("nano_size.nvdb", "a grid's bytes");
+    refused("nano_child.nvdb", "a child node outside the grid");
 }
 
 int main(int argc, char** argv)
