@@ -451,6 +451,7 @@ typedef struct read_target {
     int width, height;
     int min_x, min_y; /* data window origin */
     uint64_t file_size;
+    uint64_t* chunk_too_big; /* set to a chunk's unpacked bytes when over VEIL_EXR_MAX_CHUNK */
 } read_target;
 
 /* Decodes one chunk whose top-left pixel is (x0, y0) relative to the data
@@ -464,10 +465,15 @@ static exr_result_t decode_chunk(exr_const_context_t ctx, const exr_chunk_info_t
         return EXR_ERR_INCORRECT_CHUNK;
     /* Before the image is allocated, every chunk is found in the file: a
      * header may claim 16384^2 pixels in a file of a few bytes. */
-    if (!t->pixels)
+    if (!t->pixels) {
+        if (ci->unpacked_size > VEIL_EXR_MAX_CHUNK) {
+            *t->chunk_too_big = ci->unpacked_size;
+            return EXR_ERR_INVALID_ARGUMENT;
+        }
         return ci->data_offset <= t->file_size && ci->packed_size <= t->file_size - ci->data_offset
                    ? EXR_ERR_SUCCESS
                    : EXR_ERR_BAD_CHUNK_LEADER;
+    }
     rv = *pipeline_ready ? exr_decoding_update(ctx, 0, ci, dec) : exr_decoding_initialize(ctx, 0, ci, dec);
     if (rv != EXR_ERR_SUCCESS) return rv;
     *pipeline_ready = 1;
@@ -544,6 +550,9 @@ static veil_result read_pixels(exr_const_context_t ctx, const char* path, exr_st
         }
     }
     if (ready) exr_decoding_destroy(ctx, &dec);
+    if (rv != EXR_ERR_SUCCESS && *t->chunk_too_big)
+        return veil_fail(err, VEIL_ERR_LIMIT, "%s: the OpenEXR chunk at %s unpacks to %" PRIu64 " bytes, more than the "
+                         "%d MiB veil reads in a chunk", path, where, *t->chunk_too_big, (int)(VEIL_EXR_MAX_CHUNK >> 20));
     if (rv != EXR_ERR_SUCCESS)
         return veil_fail(err, VEIL_ERR_IO, "%s: cannot read OpenEXR pixel data (%s): %s [%s]", path, where,
                          exr_reason(msgs, rv), exr_get_error_code_as_string(rv));
@@ -627,7 +636,8 @@ static veil_result read_channels(exr_const_context_t ctx, const char* path, uint
     }
 
     /* each chunk of the image is where the chunk table says, inside the file, before the image is allocated */
-    read_target t = {n, req->names, NULL, (int)w, (int)h, dw.min.x, dw.min.y, file_size};
+    uint64_t too_big = 0;
+    read_target t = {n, req->names, NULL, (int)w, (int)h, dw.min.x, dw.min.y, file_size, &too_big};
     veil_result r = read_pixels(ctx, path, storage, &t, msgs, err);
     if (r != VEIL_OK) return r;
 

@@ -39,6 +39,11 @@ veil_result veil_read_exr_channel(const char* path, const char* name, int* width
  * the file (the chunk table's offsets and the chunks' sizes inside it). */
 #define VEIL_EXR_MAX_PIXELS ((uint64_t)1 << 28)
 
+/* And at most this many bytes in one chunk, unpacked (OpenEXRCore
+ * allocates a chunk's unpacked bytes before decoding it): 256 MiB, four
+ * times a 16-line chunk of a 16384-wide image with 64 float channels. */
+#define VEIL_EXR_MAX_CHUNK ((uint64_t)1 << 28)
+
 /* Reads an EXR's R, G, B, A channels (A = 1 when absent) as float into a
  * newly malloc'd buffer *rgba (free() it). Any scanline or tiled EXR that
  * OpenEXRCore decodes with half or float channels, up to

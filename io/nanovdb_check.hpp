@@ -71,8 +71,8 @@ inline void file_ok(const std::string& path)
             std::memcpy(&grid_size[g], m, 8);
             std::memcpy(&name, m + 136, 4); // after 4 uint64, 2 uint32, 2 x 3 double, 2 x 3 int32, 3 double
             if (grid_size[g] < min_grid) bad("a grid of " + std::to_string(grid_size[g]) + " bytes", at - 176);
+            if (name == 0 || name > size - at) bad("a grid name of " + std::to_string(name) + " bytes", at);
             std::string bytes(name, '\0');
-            if (name == 0) bad("a grid name of 0 bytes", at);
             read(&bytes[0], name, "a grid name");
             if (bytes.find('\0') == std::string::npos) bad("a grid name without its end", at - name);
         }
