@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/progress.h"
 #include "../gpu/gl_util.h"
 #include "../gpu/programs.h"
 #include "../scene/camera.h"
@@ -130,6 +131,27 @@ static veil_result image(int w, int h, const char* label, GLuint* tex, veil_erro
     return veil_gl_check(label, err);
 }
 
+static uint64_t g_band_work = VEIL_MARCH_DISPATCH_WORK;
+
+void veil_march_set_dispatch_work(uint64_t work) { g_band_work = work ? work : VEIL_MARCH_DISPATCH_WORK; }
+
+int veil_march_band_rows(const veil_march_desc* d, int w, int h)
+{
+    double steps = 1.0;
+    if (d->grid) {
+        float lo[3], hi[3];
+        veil_grid_medium_box(d->grid, lo, hi);
+        const double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
+        steps += sqrt(dx * dx + dy * dy + dz * dz) / ((double)d->step_voxels * d->grid->voxel);
+    }
+    for (size_t i = 0; i < d->scene->medium.source_count; ++i)
+        if (d->scene->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL) steps += 64.0;
+    const double per_row = (double)w * steps * (1.0 + d->light_count);
+    double rows = floor((double)g_band_work / per_row / VEIL_MARCH_GROUP) * VEIL_MARCH_GROUP;
+    if (rows < VEIL_MARCH_GROUP) rows = VEIL_MARCH_GROUP;
+    return rows >= h ? h : (int)rows;
+}
+
 veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_set* out, veil_error* err)
 {
     veil_image_set_free(out);
@@ -180,7 +202,22 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         glBindTextureUnit(VEIL_TEX_DIFFUSION, d->diffusion ? d->diffusion->texture : 0);
         glBindTextureUnit(VEIL_TEX_EMISSION, d->grid ? d->emission : 0);
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], tex[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        glDispatchCompute(veil_groups(w, VEIL_MARCH_GROUP), veil_groups(h, VEIL_MARCH_GROUP), 1);
+        const GLuint program = d->grid && d->sparse ? m->program_sparse[d->emission != 0]
+                               : d->grid && d->emission ? m->program_emission : m->program;
+        const GLint first_row = glGetUniformLocation(program, "u_first_row");
+        const int band = veil_march_band_rows(d, w, h);
+        const int report = veil_progress_wanted();
+        if (report) veil_progress("march, rows", 0, h);
+        for (int y = 0; y < h; y += band) {
+            glProgramUniform1i(program, first_row, y);
+            glDispatchCompute(veil_groups(w, VEIL_MARCH_GROUP), veil_groups(h - y < band ? h - y : band, VEIL_MARCH_GROUP), 1);
+            if (report) { /* what is reported is done */
+                glFinish();
+                veil_progress("march, rows", y + band < h ? y + band : h, h);
+            } else {
+                glFlush();
+            }
+        }
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         for (int t = 0; t <= VEIL_TEX_EMISSION; ++t) glBindTextureUnit((GLuint)t, 0);

@@ -30,6 +30,15 @@
  * 1/r^2 singularity is integrable in the continuum but not in samples). */
 #define VEIL_MIN_LIGHT_DISTANCE_VOXELS 1e-3f
 
+/* The march goes in bands of rows, as many rows a dispatch as keep its
+ * estimated work (pixels x steps a ray x (1 + lights)) under this: a GPU
+ * watchdog stops a dispatch of a few seconds, and a 16384^2 frame through
+ * a dense volume is 10^11 steps. At 10^9 to 10^10 steps a second (a
+ * desktop GPU) a band takes 0.03 to 0.3 s; on llvmpipe bands only add
+ * progress reports. The estimate of steps a ray: the volume box's diagonal
+ * over the step, plus 64 a fog. */
+#define VEIL_MARCH_DISPATCH_WORK ((uint64_t)1 << 28)
+
 typedef struct veil_march veil_march;
 
 /* A multiply scattered fluence field the march reads (render/diffusion.h). */
@@ -70,6 +79,12 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* ou
 
 /* Marches every pixel and reads the image set back (*out: freed first). */
 veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_set* out, veil_error* err);
+
+/* The rows of a band for d at w x h (a multiple of VEIL_MARCH_GROUP, or h). */
+int veil_march_band_rows(const veil_march_desc* d, int w, int h);
+
+/* Tests: the work budget of a band (0: VEIL_MARCH_DISPATCH_WORK again). */
+void veil_march_set_dispatch_work(uint64_t work);
 
 /* One light in the GPU's shape. */
 void veil_gpu_light_from(const veil_light* l, veil_gpu_light* out);

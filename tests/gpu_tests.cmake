@@ -23,6 +23,9 @@ add_test(NAME cli_progress_tty
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/progress_tty.sh $<TARGET_FILE:veil_cli>
           ${PROJECT_SOURCE_DIR}/data/scenes/rbf_fog.json)
 set_tests_properties(cli_progress_tty PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)
+# The march in bands of rows equals one dispatch, bit for bit (tests/test_march_bands.c).
+veil_test(test_march_bands SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_march_bands.c LABELS gpu
+          ARGS ${PROJECT_SOURCE_DIR}/data/scenes/rbf_fog.json)
 veil_test(test_render_cache SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_render_cache.c LABELS gpu)
 # The marcher against closed forms (airlight, a Gaussian's erf, slanted
 # exponential fog) within step-error bounds derived in the test.
