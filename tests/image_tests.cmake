@@ -1,4 +1,4 @@
-# Image files (io/exr.c, io/png.c): EXR round trips, foreign EXR inputs (half,
+# Image files (io/exr.c, io/exr_read.c, io/png.c): EXR round trips, foreign EXR inputs (half,
 # tiled, extra channels), failure cleanup, the PNG preview and its tone curve.
 # The tests also call OpenEXRCore and libpng directly (to inspect the files
 # they get and to make inputs veil never writes), so they link them themselves.

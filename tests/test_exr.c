@@ -1,4 +1,4 @@
-/* Tests for io/exr.c: EXR write/read, named planes and channels, foreign
+/* Tests for io/exr.c and io/exr_read.c: EXR write/read, named planes and channels, foreign
  * inputs, failure cleanup. */
 #define _POSIX_C_SOURCE 200809L
 
