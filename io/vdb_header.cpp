@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -94,20 +95,25 @@ public:
     // instance's parent is not found (OpenVDB's lookup may differ).
     void trees(const std::string& name)
     {
-        std::vector<const grid*> todo;
-        for (const grid& g : grids_)
-            if (g.name.substr(0, g.name.find('\x1e')) == name) todo.push_back(&g);
+        std::vector<char> want(grids_.size(), 0); // each grid once, whatever the names repeat
+        std::vector<size_t> todo;
+        std::unordered_map<std::string, std::vector<size_t>> by_name; // unique name -> grids (made when needed)
+        for (size_t i = 0; i < grids_.size(); ++i)
+            if (grids_[i].name.substr(0, grids_[i].name.find('\x1e')) == name) want[i] = 1, todo.push_back(i);
         bool all = todo.empty(); // OpenVDB may find what this does not: then every tree is walked
         for (size_t k = 0; k < todo.size() && !all; ++k) {
-            const grid& g = *todo[k];
+            const grid& g = grids_[todo[k]];
             if (g.parent.empty()) continue;
-            bool found = false;
-            for (const grid& p : grids_)
-                if (p.name == g.parent && k < grids_.size()) todo.push_back(&p), found = true;
-            all = !found;
+            if (by_name.empty())
+                for (size_t i = 0; i < grids_.size(); ++i) by_name[grids_[i].name].push_back(i);
+            auto p = by_name.find(g.parent);
+            all = p == by_name.end();
+            if (!all)
+                for (size_t i : p->second)
+                    if (!want[i]) want[i] = 1, todo.push_back(i);
         }
-        for (const grid& g : grids_)
-            if (g.parent.empty() && (all || std::find(todo.begin(), todo.end(), &g) != todo.end())) tree(g);
+        for (size_t i = 0; i < grids_.size(); ++i)
+            if (grids_[i].parent.empty() && (all || want[i])) tree(grids_[i]);
     }
 
 private:
@@ -308,31 +314,28 @@ private:
             }
         }
         limit within(*this, g.block, g.end);
-        for (const mask& m : leaves_) {
-            if (std::memcmp(bytes(64, "a leaf's value mask"), m.bits, 64) != 0) {
+        // OpenVDB counts a leaf's values by one of its two masks (the
+        // topology's when it seeks, the buffer's when it reads): their
+        // counts must agree (only the count sizes anything; a count a leaf
+        // keeps the walk's memory at 2 bytes a leaf of at least 129 in the file)
+        for (uint16_t count : leaves_) {
+            const uint32_t again = ones((const unsigned char*)bytes(64, "a leaf's value mask"), 64);
+            if (again != count) {
                 char msg[200];
-                std::snprintf(msg, sizeof msg, "corrupt OpenVDB file: a leaf's value mask differs from its topology's "
-                              "(at byte %llu)", (unsigned long long)at_);
+                std::snprintf(msg, sizeof msg, "corrupt OpenVDB file: a leaf's value mask has %u values on, its "
+                              "topology's %u (at byte %llu)", again, (unsigned)count, (unsigned long long)at_);
                 throw std::string(msg);
             }
             if (bool_) skip(12 + 64, "a bool leaf's origin and values");
-            else values(512, m.count);
+            else values(512, count);
         }
     }
-
-    struct mask {
-        unsigned char bits[64];
-        uint32_t count;
-    };
 
     // A node of (2^log2)³ below the root; log2 3 is a leaf.
     void node(int log2)
     {
         if (log2 == 3) {
-            mask m;
-            std::memcpy(m.bits, bytes(64, "a leaf's value mask"), 64);
-            m.count = ones(m.bits, 64);
-            leaves_.push_back(m);
+            leaves_.push_back((uint16_t)ones((const unsigned char*)bytes(64, "a leaf's value mask"), 64));
             return;
         }
         const uint32_t n = 1u << (3 * log2), mask_bytes = n / 8;
@@ -496,7 +499,7 @@ private:
     // the tree being walked
     uint32_t compression_ = 0, value_ = 0, stored_ = 0;
     bool bool_ = false;
-    std::vector<mask> leaves_;
+    std::vector<uint16_t> leaves_; // each leaf's active values, in the order of the buffers
 };
 
 } // namespace
