@@ -1,11 +1,16 @@
 /* libFuzzer target: the OpenVDB reader (io/vdb.h): the file's grids, then
- * its density grid opened, as `veil info` and `veil render` read them. */
+ * its density grid opened, as `veil info` and `veil render` read them.
+ * fuzz_nanovdb.c is this target for .nvdb files (FUZZ_VDB_FILE). */
 #include "fuzz_common.h"
 #include "io/vdb.h"
 
+#ifndef FUZZ_VDB_FILE
+#define FUZZ_VDB_FILE "f.vdb" /* the reader is chosen by the name's suffix */
+#endif
+
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 {
-    const char* path = fuzz_file(data, size, "f.vdb");
+    const char* path = fuzz_file(data, size, FUZZ_VDB_FILE);
     veil_vdb_grid_info* grids = NULL;
     size_t count = 0;
     veil_error err = {0};
