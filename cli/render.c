@@ -20,8 +20,9 @@
 typedef struct render_args {
     const char *scene, *exr, *png;
     long width, height, seed, frames;
-    float step;
+    float step, sun_across, sun_along;
     veil_opv_method method;
+    veil_quality quality;
     int stats, explain, aovs;
 } render_args;
 
@@ -36,7 +37,7 @@ static int parse_render_args(int argc, char** argv, render_args* a)
         if (!strcmp(s, "--aovs")) { a->aovs = 1; continue; }
         int takes = !strcmp(s, "-o") || !strcmp(s, "--png") || !strcmp(s, "--width") || !strcmp(s, "--height") ||
                     !strcmp(s, "--step") || !strcmp(s, "--seed") || !strcmp(s, "--method") ||
-                    !strcmp(s, "--turntable");
+                    !strcmp(s, "--turntable") || !strcmp(s, "--quality") || !strcmp(s, "--od-spacing");
         if (takes && !v) return veil_cli_usage_error("%s needs a value", s);
         if (!strcmp(s, "-o")) a->exr = v;
         else if (!strcmp(s, "--png")) a->png = v;
@@ -52,7 +53,17 @@ static int parse_render_args(int argc, char** argv, render_args* a)
             if (!veil_cli_parse_int(v, 1, 100000, &a->frames)) return veil_cli_usage_error("--turntable: expected a number of frames in 1..100000, got '%s'", v);
         } else if (!strcmp(s, "--method")) {
             if (!veil_opv_method_parse(v, &a->method))
-                return veil_cli_usage_error("--method: expected default, jacobi, jacobi-corrected, sweep or semi-lagrangian, got '%s'", v);
+                return veil_cli_usage_error("--method: expected default, jacobi, jacobi-corrected, sweep, semi-lagrangian or light-space, got '%s'", v);
+        } else if (!strcmp(s, "--quality")) {
+            if (!veil_quality_parse(v, &a->quality))
+                return veil_cli_usage_error("--quality: expected draft, default, high or max, got '%s'", v);
+        } else if (!strcmp(s, "--od-spacing")) {
+            char extra;
+            int n = sscanf(v, "%f,%f%c", &a->sun_across, &a->sun_along, &extra);
+            if (n == 1) a->sun_along = a->sun_across;
+            if ((n != 1 && n != 2) || !(a->sun_across >= 0.1f && a->sun_across <= 16.0f) ||
+                !(a->sun_along >= 0.1f && a->sun_along <= 16.0f))
+                return veil_cli_usage_error("--od-spacing: expected ACROSS[,ALONG] in voxels, each in 0.1..16, got '%s'", v);
         } else if (s[0] == '-' && s[1]) return veil_cli_usage_error("unknown option '%s'", s);
         else if (!a->scene) { a->scene = s; continue; }
         else return veil_cli_usage_error("unexpected argument '%s'", s);
@@ -81,7 +92,8 @@ static int explain(const render_args* a)
     veil_result r = veil_scene_load(a->scene, &scene, &err);
     if (r != VEIL_OK) return veil_cli_fail(r, &err);
     veil_render_opts opts = {.width = (int)a->width, .height = (int)a->height, .step_voxels = a->step,
-                             .seed = (uint32_t)a->seed, .method = a->method};
+                             .seed = (uint32_t)a->seed, .method = a->method, .quality = a->quality,
+                             .sun_across = a->sun_across, .sun_along = a->sun_along};
     char* text = NULL;
     r = veil_plan_explain(&scene, &opts, a->frames > 0 ? a->frames : 1, &text, &err);
     if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a->scene);
@@ -121,7 +133,8 @@ int veil_cmd_render(int argc, char** argv)
     for (long f = 0; f < frames && r == VEIL_OK; ++f) {
         veil_camera cam = veil_camera_of_frame(&scene.camera, f, frames);
         veil_render_opts opts = {.width = (int)a.width, .height = (int)a.height, .step_voxels = a.step,
-                                 .seed = (uint32_t)a.seed, .method = a.method, .camera = &cam};
+                                 .seed = (uint32_t)a.seed, .method = a.method, .quality = a.quality,
+                                 .sun_across = a.sun_across, .sun_along = a.sun_along, .camera = &cam};
         veil_render_stats st = {0};
         char label[64] = "";
         if (frames > 1) snprintf(label, sizeof label, "frame %ld/%ld", f + 1, frames);

@@ -113,6 +113,11 @@
 #define VEIL_TEX_LIMIT 6        /* texture unit: r32f per-pixel distance where the ray ends (veil fog) */
 #define VEIL_TEX_DIFFUSION 7    /* texture unit: rgba32f multiply scattered fluence (render/diffusion.h) */
 #define VEIL_TEX_EMISSION 8     /* texture unit: rgba32f emission eps (W m^-3 sr^-1) on the EV's grid */
+/* Texture units 9..12: r32f optical depth of up to VEIL_MAX_SUNS suns in
+ * their light-space grids (propagate/sun_space.h). Only over a dense EV,
+ * so they share units with the sparse tables (9..13), never bound then. */
+#define VEIL_MAX_SUNS 4
+#define VEIL_TEX_SUN0 9
 
 /* A light as the GPU sees it: one shape for every shader (std140, 48 bytes).
  * Filled from scene/scene.h's veil_light by veil_gpu_light_from(). */
@@ -154,6 +159,11 @@ VEIL_STRUCT_BEGIN(veil_march_block)
     VEIL_V4(diffusion_inv); /* xyz: texture coordinates per m */
     veil_gpu_light lights[VEIL_MAX_LIGHTS];
     veil_gpu_fog fogs[VEIL_MAX_FOGS];
+    VEIL_IV4(sun_of[VEIL_MAX_LIGHTS / 4]); /* [l / 4][l % 4]: 1 + the light-space grid holding light l's
+                                              optical depth; 0: its channel of the OPVs */
+    VEIL_V4(sun_map[3 * VEIL_MAX_SUNS]);   /* 3k .. 3k+2: grid k's world -> texture rows (xyz . x + w) */
+    VEIL_V4(sun_step[VEIL_MAX_SUNS]);      /* grid k: x: node spacing along the light (m), y: nodes along it,
+                                              z: density samples of the last stretch (render/shaders/medium_common.glsl) */
 VEIL_STRUCT_END(veil_march_block)
 
 /* ---- the sparse extinction volume (volume/sparse.h) --------------------- */

@@ -1,5 +1,6 @@
 #include "plan.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -129,15 +130,33 @@ veil_result veil_plan_explain(const veil_scene* s, const veil_render_opts* opts,
     } else if (n == 0) {
         put(&t, "propagate  skipped on every frame: no light reaches the medium\n");
     } else {
-        veil_opv_params params = veil_render_opv_params(s, o.method);
-        put(&t, "propagate  frame 0: runs, %d light%s (%s), %d texture%s:", n, n == 1 ? "" : "s",
-            v.sparse ? "sparse: brick by brick in the light's order" : veil_opv_method_name(o.method), (n + 3) / 4,
-            (n + 3) / 4 == 1 ? "" : "s");
+        veil_opv_params params = veil_render_opv_params(s, &o);
+        veil_opv_light ol[VEIL_MAX_LIGHTS];
+        veil_opv_sun suns[VEIL_MAX_SUNS];
+        uint64_t sun_keys[VEIL_MAX_SUNS];
+        /* the GL's 3D textures reach at least VEIL_GL_MIN_3D_TEXTURE texels an axis (no GL here) */
+        int n_suns = veil_opv_plan_suns(g, ev_key, used, n, &params, v.sparse ? 0 : VEIL_GL_MIN_3D_TEXTURE, ol, suns,
+                                        sun_keys);
+        int textures = 0;
         for (int tex = 0; 4 * tex < n; ++tex) {
-            veil_opv_light ol[4];
-            int count = n - 4 * tex < 4 ? n - 4 * tex : 4;
-            for (int c = 0; c < count; ++c) veil_opv_light_from_world(g, &used[4 * tex + c], &ol[c]);
-            put(&t, " key %016llx", (unsigned long long)veil_opv_texture_key(ev_key, &params, ol, count));
+            int count = n - 4 * tex < 4 ? n - 4 * tex : 4, on_grid = 0;
+            for (int c = 0; c < count; ++c) on_grid += !ol[4 * tex + c].elsewhere;
+            textures += on_grid > 0;
+        }
+        put(&t, "propagate  frame 0: runs, %d light%s (%s), %d texture%s", n, n == 1 ? "" : "s",
+            v.sparse ? "sparse: brick by brick in the light's order" : veil_opv_method_name(o.method), textures,
+            textures == 1 ? "" : "s");
+        for (int tex = 0; 4 * tex < n; ++tex) {
+            int count = n - 4 * tex < 4 ? n - 4 * tex : 4, on_grid = 0;
+            for (int c = 0; c < count; ++c) on_grid += !ol[4 * tex + c].elsewhere;
+            if (on_grid)
+                put(&t, " key %016llx", (unsigned long long)veil_opv_texture_key(ev_key, &params, ol + 4 * tex, count));
+        }
+        for (int q = 0; q < n_suns; ++q) {
+            const float* a = suns[q].space.axis[0];
+            put(&t, "%s light %d in a light-space grid of %dx%dx%d nodes %.3g voxels apart across, key %016llx",
+                q ? "," : ";", suns[q].light, suns[q].space.nodes[0], suns[q].space.nodes[1], suns[q].space.nodes[2],
+                sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]), (unsigned long long)sun_keys[q]);
         }
         put(&t, "\n");
         if (frames > 1) {
@@ -148,8 +167,9 @@ veil_result veil_plan_explain(const veil_scene* s, const veil_render_opts* opts,
     }
 
     /* render */
-    put(&t, "render     every frame: runs, %dx%d, step %g voxels, %d light%s%s (depends on the camera)\n", o.width,
-        o.height, o.step_voxels, n, n == 1 ? "" : "s", fogs ? ", analytic fog in closed form" : "");
+    put(&t, "render     every frame: runs, %dx%d, quality %s, step %g voxels, %d light%s%s (depends on the camera)\n",
+        o.width, o.height, veil_quality_name(o.quality), o.step_voxels, n, n == 1 ? "" : "s",
+        fogs ? ", analytic fog in closed form" : "");
     const veil_multiple* ms = &s->multiple;
     if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_DIFFUSION)
         put(&t, "           multiple scattering: the diffusion field (stage volumetric: once, %d cells along the "

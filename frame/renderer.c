@@ -79,8 +79,14 @@ veil_render_opts veil_render_opts_resolve(const veil_render_opts* opts, const ve
     if (!o.camera) o.camera = &s->camera;
     if (o.width <= 0) o.width = o.camera->width;
     if (o.height <= 0) o.height = o.camera->height;
-    if (!(o.step_voxels > 0.0f)) o.step_voxels = VEIL_DEFAULT_STEP_VOXELS;
+    if (o.quality <= VEIL_QUALITY_UNSET || o.quality >= VEIL_QUALITY_COUNT)
+        o.quality = s->quality > VEIL_QUALITY_UNSET && s->quality < VEIL_QUALITY_COUNT ? s->quality : VEIL_QUALITY_DEFAULT;
+    const veil_quality_rung* q = veil_quality_rung_of(o.quality);
+    if (!(o.step_voxels > 0.0f)) o.step_voxels = q->step_voxels;
+    if (o.method == VEIL_OPV_DEFAULT) o.method = q->method;
     o.method = veil_opv_method_resolve(o.method);
+    if (!(o.sun_across > 0.0f)) o.sun_across = q->sun_across;
+    if (!(o.sun_along > 0.0f)) o.sun_along = q->sun_along;
     return o;
 }
 
@@ -185,13 +191,29 @@ static veil_result inject_scene(veil_renderer* r, const veil_scene* s, veil_rend
 
 /* ---- stage 2: propagate ------------------------------------------------ */
 
-veil_opv_params veil_render_opv_params(const veil_scene* s, veil_opv_method method)
+/* The ladder, chosen from bench/peers (docs/performance.md): each rung
+ * neither slower nor less accurate than the one below it on every scene measured. */
+static const veil_quality_rung rungs[VEIL_QUALITY_COUNT] = {
+    [VEIL_QUALITY_DRAFT] = {1.0f, VEIL_OPV_LIGHT_SPACE, 1.0f, 4.0f},
+    [VEIL_QUALITY_DEFAULT] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.5f, 4.0f},
+    [VEIL_QUALITY_HIGH] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.35f, 4.0f},
+    [VEIL_QUALITY_MAX] = {0.25f, VEIL_OPV_LIGHT_SPACE, 0.25f, 4.0f},
+};
+
+const veil_quality_rung* veil_quality_rung_of(veil_quality q)
+{
+    return &rungs[q > VEIL_QUALITY_UNSET && q < VEIL_QUALITY_COUNT ? q : VEIL_QUALITY_DEFAULT];
+}
+
+veil_opv_params veil_render_opv_params(const veil_scene* s, const veil_render_opts* o)
 {
     float st_max = 0.0f;
     for (int c = 0; c < 3; ++c) st_max = fmaxf(st_max, s->medium.sigma_a[c] + s->medium.sigma_s[c]);
     /* D changes of tol move tau by at most st_max * tol */
-    return (veil_opv_params){.method = veil_opv_method_resolve(method),
-                             .tolerance = st_max > 0.0f ? VEIL_OPV_TAU_TOLERANCE / st_max : INFINITY};
+    veil_opv_params p = {.method = veil_opv_method_resolve(o->method),
+                         .tolerance = st_max > 0.0f ? VEIL_OPV_TAU_TOLERANCE / st_max : INFINITY,
+                         .sun_across = o->sun_across, .sun_along = o->sun_along};
+    return p;
 }
 
 static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_light* lights, int n,
@@ -209,11 +231,11 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
         why(rep, "no light reaches the medium (of %zu)", s->light_count);
         return VEIL_OK;
     }
-    veil_opv_params params = veil_render_opv_params(s, o->method);
+    veil_opv_params params = veil_render_opv_params(s, o);
     veil_opv_report orep = {0};
     const veil_ev_sparse* sp = veil_ev_sparse_of(r->ev);
-    veil_result res = veil_opv_set_update(r->opv, g, veil_ev_texture(r->ev), sp, r->ev_key, lights, n, &params,
-                                             &orep, err);
+    veil_result res = veil_opv_set_update(r->opv, g, veil_ev_texture(r->ev), o->no_skip ? 0 : veil_ev_occupancy(r->ev),
+                                          sp, r->ev_key, lights, n, &params, &orep, err);
     st->opv_computed = orep.computed;
     st->opv_cached = orep.cached;
     st->propagate_iterations = orep.iterations;
@@ -223,16 +245,18 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
         veil_opv_light_from_world(g, &lights[l], &ol);
         rep->key = veil_hash_bytes(rep->key, &ol, sizeof ol);
     }
-    rep->status = orep.computed ? VEIL_STAGE_RAN : VEIL_STAGE_CACHED;
+    rep->status = orep.computed || orep.suns_computed ? VEIL_STAGE_RAN : VEIL_STAGE_CACHED;
     const char* method = sp ? "sparse: brick by brick in the light's order" : veil_opv_method_name(o->method);
     char from[64] = "";
     if (st->emission_lights) snprintf(from, sizeof from, " (+%d from the emission)", st->emission_lights);
-    const int* td = sp ? sp->atlas_texels : g->dims;
-    double mib = (double)td[0] * td[1] * td[2] * 16.0 * ((n + 3) / 4) / 1048576.0;
-    if (orep.computed)
-        why(rep, "%d of %zu lights%s, %s, %d passes; %d textures computed (volume or light moved), %d cached; "
+    char suns[128] = "";
+    if (orep.suns)
+        snprintf(suns, sizeof suns, "; %d sun%s in light-space grids (%d computed), %.3g voxels apart across",
+                 orep.suns, orep.suns > 1 ? "s" : "", orep.suns_computed, orep.sun_across);
+    if (orep.computed || orep.suns_computed)
+        why(rep, "%d of %zu lights%s, %s, %d passes; %d textures computed (volume or light moved), %d cached%s; "
             "%.1f MiB", n - st->emission_lights, s->light_count, from, method, orep.iterations, orep.computed,
-            orep.cached, mib);
+            orep.cached, suns, orep.mib);
     else
         why(rep, "%d lights, %s: the volume, method and lights' geometry are unchanged", n, method);
     return res;
@@ -386,11 +410,13 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
     if (res != VEIL_OK) return res;
     GLuint opv[VEIL_MAX_OPV_TEXTURES];
     for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) opv[t] = veil_opv_set_texture(r->opv, t);
+    int sun_count = 0;
     veil_march_desc md = {.scene = s, .camera = o->camera, .width = o->width, .height = o->height,
                           .lights = lights, .light_count = n, .grid = g,
                           .ev = veil_ev_texture(r->ev), .occupancy = veil_ev_occupancy(r->ev),
                           .sparse = veil_ev_sparse_of(r->ev),
                           .emission = veil_ev_emission(r->ev), .opv = opv,
+                          .suns = veil_opv_set_suns(r->opv, &sun_count), .sun_count = sun_count,
                           .step_voxels = o->step_voxels, .seed = o->seed, .skip_empty = !o->no_skip,
                           .max_distance = o->max_distance, .end_distance = o->behind_distance,
                           .no_background = o->behind != NULL};
@@ -414,8 +440,8 @@ static veil_result light_and_march(veil_renderer* r, const veil_scene* s, const 
     rep->ms = veil_now_ms() - t1;
     rep->status = VEIL_STAGE_RAN;
     const veil_multiple* ms = &s->multiple;
-    why(rep, "%dx%d, %d lights, step %g voxels%s: depends on the camera, runs every frame", o->width, o->height, n,
-        o->step_voxels,
+    why(rep, "%dx%d, %d lights, quality %s, step %g voxels%s: depends on the camera, runs every frame", o->width,
+        o->height, n, veil_quality_name(o->quality), o->step_voxels,
         !ms->volumetric ? ""
         : ms->volumetric_method == VEIL_VOLUMETRIC_DIFFUSION ? ", multiple scattering from the diffusion field"
         : ms->octaves > 1 ? ", volumetric multiple scattering (octaves)" : "");

@@ -44,9 +44,11 @@ typedef struct veil_renderer veil_renderer;
  * what zero resolves to. */
 typedef struct veil_render_opts {
     int width, height;      /* 0: the camera's */
-    float step_voxels;      /* 0: VEIL_DEFAULT_STEP_VOXELS */
+    float step_voxels;      /* 0: the quality rung's */
     uint32_t seed;          /* jitter seed */
-    veil_opv_method method; /* 0: VEIL_OPV_DEFAULT_METHOD */
+    veil_opv_method method; /* 0: the quality rung's */
+    veil_quality quality;   /* UNSET: the scene's "quality", else VEIL_QUALITY_DEFAULT */
+    float sun_across, sun_along; /* light-space grids' node spacing (voxels); 0: the rung's */
     const veil_camera* camera; /* NULL: the scene's (turntables move it) */
     int no_skip;            /* 1: march through empty bricks too (to measure what skipping saves) */
     /* > 0: rays stop at the first step boundary at or beyond this distance
@@ -108,9 +110,18 @@ veil_result veil_render_density(veil_renderer* r, const veil_scene* s, const vei
  * does; a spot whose outer cone misses the box's bounding sphere does not. */
 int veil_render_lights(const veil_scene* s, const veil_grid* g, veil_light* out);
 
-/* The propagation parameters for s: the method, and the Jacobi tolerance
- * on D that keeps sigma_t D within VEIL_OPV_TAU_TOLERANCE. */
-veil_opv_params veil_render_opv_params(const veil_scene* s, veil_opv_method method);
+/* The propagation parameters for s under resolved options o: the method,
+ * the light-space spacing, and the Jacobi tolerance on D that keeps
+ * sigma_t D within VEIL_OPV_TAU_TOLERANCE. */
+veil_opv_params veil_render_opv_params(const veil_scene* s, const veil_render_opts* o);
+
+/* What a rung of the quality ladder sets (each 0 left to the options). */
+typedef struct veil_quality_rung {
+    float step_voxels;
+    veil_opv_method method;
+    float sun_across, sun_along;
+} veil_quality_rung;
+const veil_quality_rung* veil_quality_rung_of(veil_quality q); /* UNSET: the default rung */
 
 /* Stage access for tests: GPU splat read back (veil_grid_voxels floats) and
  * GPU propagation read back (n_lights * voxels floats, light-major). */

@@ -19,7 +19,9 @@
 
 #define SCENE_MAX_FILE_BYTES ((size_t)256 << 20) /* 256 MiB */
 
-static const char* const ROOT_KEYS[] = {"camera", "medium", "lights", "background", "multiple_scattering", NULL};
+static const char* const ROOT_KEYS[] = {"camera", "medium", "lights", "background", "multiple_scattering", "quality",
+                                        NULL};
+static const char* const QUALITIES[] = {"draft", "default", "high", "max", NULL}; /* = veil_quality - 1 */
 static const char* const CAMERA_KEYS[] = {"position", "look_at", "up", "fov_y_deg", "width", "height", NULL};
 static const char* const MEDIUM_KEYS[] = {"sigma_a", "sigma_s", "phase", "max_resolution", "representation",
                                            "sources", NULL};
@@ -178,6 +180,9 @@ static veil_result parse_root(const ctx* c, const cJSON* root, veil_scene* s)
     TRY(parse_medium(c, root, &s->medium));
     TRY(parse_lights(c, root, s));
     TRY(veil__parse_multiple(c, root, &s->multiple));
+    int q = -1;
+    TRY(veil__jr_get_name(c, root, NULL, "quality", QUALITIES, &q));
+    s->quality = (veil_quality)(q + 1);
     return parse_background(c, root, s->background);
 }
 

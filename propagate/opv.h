@@ -25,6 +25,12 @@
  *    shells around a point light's voxel (see opv_plan.h for why each
  *    voxel reads only voxels already done); the 27 voxels around a point
  *    light integrate their segment directly (VEIL_NEAR_SAMPLES points).
+ *  - VEIL_OPV_LIGHT_SPACE: each sun (up to VEIL_MAX_SUNS) in its own
+ *    light-space grid, one prefix sum down each column (sun_space.h);
+ *    point and spot lights, further suns and sparse volumes as
+ *    VEIL_OPV_SEMI_LAGRANGIAN. The functions of this header work on the
+ *    EV's grid only: for them it is VEIL_OPV_SEMI_LAGRANGIAN; opv_set.h
+ *    makes the light-space grids.
  * Spot lights propagate as point lights (the cone only weights the marcher).
  */
 #ifndef VEIL_OPV_H
@@ -34,6 +40,7 @@
 #include "../core/shared.glsl.h"
 #include "../scene/scene.h"
 #include "../volume/volume.h"
+#include "sun_space.h"
 
 typedef enum veil_opv_method {
     VEIL_OPV_DEFAULT = 0, /* resolves to VEIL_OPV_DEFAULT_METHOD */
@@ -41,18 +48,19 @@ typedef enum veil_opv_method {
     VEIL_OPV_JACOBI_CORRECTED,
     VEIL_OPV_SWEEP,
     VEIL_OPV_SEMI_LAGRANGIAN,
+    VEIL_OPV_LIGHT_SPACE,
     VEIL_OPV_METHOD_COUNT
 } veil_opv_method;
 
 /* The default, chosen from the measurements in docs/performance.md. */
-#define VEIL_OPV_DEFAULT_METHOD VEIL_OPV_SEMI_LAGRANGIAN
+#define VEIL_OPV_DEFAULT_METHOD VEIL_OPV_LIGHT_SPACE
 
 static inline veil_opv_method veil_opv_method_resolve(veil_opv_method m)
 {
     return m == VEIL_OPV_DEFAULT ? VEIL_OPV_DEFAULT_METHOD : m;
 }
 
-/* "jacobi", "jacobi-corrected", "sweep", "semi-lagrangian" ("default" for 0) */
+/* "jacobi", "jacobi-corrected", "sweep", "semi-lagrangian", "light-space" ("default" for 0) */
 const char* veil_opv_method_name(veil_opv_method m);
 /* 1 on success; names as above */
 int veil_opv_method_parse(const char* name, veil_opv_method* out);
@@ -63,6 +71,8 @@ typedef struct veil_opv_light {
     float v[3];    /* point: position (index units); directional: unit vector toward the light */
     int c[3];      /* point: the light's voxel, floor(v + 1/2) (it may lie outside the grid, at most
                       VEIL_OPV_FAR voxels beyond it: opv_cpu.c says why that changes nothing) */
+    int elsewhere; /* 1: its optical depth is kept in a light-space grid; the ordered methods leave its
+                      channel 0 (veil_opv_gpu; the Jacobi steps compute all four channels anyway) */
 } veil_opv_light;
 
 void veil_opv_light_from_world(const veil_grid* g, const veil_light* l, veil_opv_light* out);
@@ -79,6 +89,9 @@ typedef struct veil_opv_params {
                            this many voxels of the path's end; 0 = VEIL_SL_DEFAULT_EXIT_STEPS, >= 1 */
     int characteristic; /* semi-Lagrangian: voxels between interpolations (1, or 2 and more);
                            0 = VEIL_SL_DEFAULT_CHARACTERISTIC */
+    float sun_across;   /* light-space: node spacing across the light (voxels); 0 = VEIL_SUN_DEFAULT_ACROSS */
+    float sun_along;    /* ... along the light (voxels); 0 = VEIL_SUN_DEFAULT_ALONG */
+    int sun_panels;     /* ... Simpson panels per step along it; 0 = VEIL_SUN_DEFAULT_PANELS */
 } veil_opv_params;
 
 /* Chosen from the measurements in docs/performance.md. */
@@ -93,6 +106,19 @@ static inline float veil_opv_exit_steps(const veil_opv_params* p)
 static inline int veil_opv_characteristic(const veil_opv_params* p)
 {
     return p->characteristic >= 1 ? p->characteristic : VEIL_SL_DEFAULT_CHARACTERISTIC;
+}
+
+static inline float veil_opv_sun_across(const veil_opv_params* p)
+{
+    return p->sun_across > 0.0f ? p->sun_across : VEIL_SUN_DEFAULT_ACROSS;
+}
+static inline float veil_opv_sun_along(const veil_opv_params* p)
+{
+    return p->sun_along > 0.0f ? p->sun_along : VEIL_SUN_DEFAULT_ALONG;
+}
+static inline int veil_opv_sun_panels(const veil_opv_params* p)
+{
+    return p->sun_panels > 0 ? p->sun_panels : VEIL_SUN_DEFAULT_PANELS;
 }
 
 int veil_opv_exact_iterations(const veil_grid* g);

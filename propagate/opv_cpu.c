@@ -29,7 +29,7 @@ static size_t vox(const veil_grid* g, const int x[3])
 }
 
 static const char* const method_names[VEIL_OPV_METHOD_COUNT] = {"default", "jacobi", "jacobi-corrected",
-                                                                "sweep", "semi-lagrangian"};
+                                                                "sweep", "semi-lagrangian", "light-space"};
 
 const char* veil_opv_method_name(veil_opv_method m)
 {
@@ -173,6 +173,7 @@ veil_result veil_opv_cpu(const veil_grid* g, const float* rho, const veil_opv_li
     float* tmp = NULL;
     veil_opv_params resolved = *params;
     resolved.method = veil_opv_method_resolve(params->method);
+    if (resolved.method == VEIL_OPV_LIGHT_SPACE) resolved.method = VEIL_OPV_SEMI_LAGRANGIAN; /* on the grid */
     params = &resolved;
     if (params->method == VEIL_OPV_JACOBI || params->method == VEIL_OPV_JACOBI_CORRECTED) {
         tmp = malloc(nv * sizeof(float));
@@ -184,6 +185,10 @@ veil_result veil_opv_cpu(const veil_grid* g, const float* rho, const veil_opv_li
     for (int l = 0; l < n_lights; ++l) {
         float* cur = out + (size_t)l * nv;
         int it = 0;
+        if (lights[l].elsewhere && params->method != VEIL_OPV_JACOBI && params->method != VEIL_OPV_JACOBI_CORRECTED) {
+            memset(cur, 0, nv * sizeof(float));
+            continue;
+        }
         switch (params->method) {
         case VEIL_OPV_JACOBI:
         case VEIL_OPV_JACOBI_CORRECTED: jacobi(g, rho, &lights[l], params, cur, tmp, &it); break;

@@ -177,6 +177,7 @@ veil_result veil_opv_gpu(const veil_opv_programs* p, const veil_grid* g, GLuint 
     veil_result r = VEIL_OK;
     veil_opv_params resolved = *params;
     resolved.method = veil_opv_method_resolve(params->method);
+    if (resolved.method == VEIL_OPV_LIGHT_SPACE) resolved.method = VEIL_OPV_SEMI_LAGRANGIAN; /* on the grid */
     params = &resolved;
     glBindImageTexture(VEIL_IMAGE_EV, ev, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32F);
     if (params->method == VEIL_OPV_JACOBI || params->method == VEIL_OPV_JACOBI_CORRECTED) {
@@ -196,6 +197,7 @@ veil_result veil_opv_gpu(const veil_opv_programs* p, const veil_grid* g, GLuint 
             glClearTexImage(opv[t], 0, GL_RGBA, GL_FLOAT, zero);
             glBindImageTexture(VEIL_IMAGE_OPV_DST, opv[t], 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
             for (int c = 0; c < 4 && 4 * t + c < n_lights; ++c) {
+                if (lights[4 * t + c].elsewhere) continue; /* its channel stays 0 */
                 glProgramUniform1i(prog, loc(prog, "u_channel"), c);
                 int passes = sweep_light(prog, g, &lights[4 * t + c], params->method);
                 most = passes > most ? passes : most;

@@ -13,9 +13,13 @@
 struct veil_opv_set {
     veil_opv_programs programs;
     GLuint sparse_program; /* propagate/shaders/propagate_sparse.comp, made when first needed */
+    GLuint sun_program;    /* propagate/shaders/sun_prefix.comp, made when first needed */
     GLuint tex[VEIL_MAX_OPV_TEXTURES];
     int dims[VEIL_MAX_OPV_TEXTURES][3];
     uint64_t key[VEIL_MAX_OPV_TEXTURES]; /* 0: none (or being remade) */
+    veil_opv_sun sun[VEIL_MAX_SUNS];     /* the first `suns` in use */
+    uint64_t sun_key[VEIL_MAX_SUNS];     /* 0: none (or being remade) */
+    int suns;
 };
 
 veil_result veil_opv_set_create(veil_opv_set** out, veil_error* err)
@@ -32,12 +36,21 @@ veil_result veil_opv_set_create(veil_opv_set** out, veil_error* err)
     return VEIL_OK;
 }
 
+static void drop_sun(veil_opv_set* s, int k)
+{
+    glDeleteTextures(1, &s->sun[k].texture);
+    memset(&s->sun[k], 0, sizeof s->sun[k]);
+    s->sun_key[k] = 0;
+}
+
 void veil_opv_set_clear(veil_opv_set* s)
 {
     glDeleteTextures(VEIL_MAX_OPV_TEXTURES, s->tex);
     memset(s->tex, 0, sizeof s->tex);
     memset(s->dims, 0, sizeof s->dims);
     memset(s->key, 0, sizeof s->key);
+    for (int k = 0; k < VEIL_MAX_SUNS; ++k) drop_sun(s, k);
+    s->suns = 0;
 }
 
 void veil_opv_set_destroy(veil_opv_set* s)
@@ -45,11 +58,18 @@ void veil_opv_set_destroy(veil_opv_set* s)
     if (!s) return;
     veil_opv_set_clear(s);
     glDeleteProgram(s->sparse_program);
+    glDeleteProgram(s->sun_program);
     veil_opv_programs_destroy(&s->programs);
     free(s);
 }
 
 GLuint veil_opv_set_texture(const veil_opv_set* s, int t) { return s->tex[t]; }
+
+const veil_opv_sun* veil_opv_set_suns(const veil_opv_set* s, int* count)
+{
+    *count = s->suns;
+    return s->sun;
+}
 
 uint64_t veil_opv_texture_key(uint64_t ev_key, const veil_opv_params* params, const veil_opv_light* lights, int count)
 {
@@ -189,22 +209,154 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
     return r;
 }
 
-veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, const veil_ev_sparse* sp,
-                                uint64_t ev_key, const veil_light* lights, int n, const veil_opv_params* params,
-                                veil_opv_report* rep, veil_error* err)
+/* Fills texture tex (r32f, the nodes of sp) with one sun's light-space
+ * optical depth over the EV texture ev (occ: its occupancy bricks, 0: no
+ * skipping). */
+static veil_result sun_depths(veil_opv_set* s, const veil_grid* g, GLuint ev, GLuint occ, const veil_sun_space* sp,
+                              GLuint tex, veil_error* err)
+{
+    veil_result r = VEIL_OK;
+    if (!s->sun_program) r = veil_gpu_program("propagate/shaders/sun_prefix.comp", &s->sun_program, err);
+    if (r != VEIL_OK) return r;
+    GLuint p = s->sun_program;
+    const float* c = sp->axis[2];
+    glProgramUniform3i(p, glGetUniformLocation(p, "u_dims"), g->dims[0], g->dims[1], g->dims[2]);
+    glProgramUniform3i(p, glGetUniformLocation(p, "u_nodes"), sp->nodes[0], sp->nodes[1], sp->nodes[2]);
+    glProgramUniform3fv(p, glGetUniformLocation(p, "u_origin"), 1, sp->origin);
+    glProgramUniform3fv(p, glGetUniformLocation(p, "u_axis_a"), 1, sp->axis[0]);
+    glProgramUniform3fv(p, glGetUniformLocation(p, "u_axis_b"), 1, sp->axis[1]);
+    glProgramUniform3fv(p, glGetUniformLocation(p, "u_axis_c"), 1, sp->axis[2]);
+    glProgramUniform1i(p, glGetUniformLocation(p, "u_panels"), sp->panels);
+    glProgramUniform1f(p, glGetUniformLocation(p, "u_step"), sqrtf(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) * g->voxel);
+    glProgramUniform1i(p, glGetUniformLocation(p, "u_skip"), occ != 0);
+    glUseProgram(p);
+    glBindTextureUnit(VEIL_TEX_EV, ev);
+    glBindTextureUnit(VEIL_TEX_OCC, occ);
+    glBindImageTexture(VEIL_IMAGE_OPV_DST, tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+    glDispatchCompute(veil_groups(sp->nodes[0], 8), veil_groups(sp->nodes[1], 8), 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    glBindImageTexture(VEIL_IMAGE_OPV_DST, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+    glBindTextureUnit(VEIL_TEX_EV, 0);
+    glBindTextureUnit(VEIL_TEX_OCC, 0);
+    glUseProgram(0);
+    return veil_gl_check("a sun's light-space optical depth (propagate/shaders/sun_prefix.comp)", err);
+}
+
+int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* lights, int n,
+                       const veil_opv_params* params, int max_axis, veil_opv_light* ol, veil_opv_sun* want,
+                       uint64_t* want_key)
+{
+    int count = 0;
+    for (int l = 0; l < n; ++l) veil_opv_light_from_world(g, &lights[l], &ol[l]);
+    if (veil_opv_method_resolve(params->method) != VEIL_OPV_LIGHT_SPACE) return 0;
+    for (int l = 0; l < n && count < VEIL_MAX_SUNS; ++l) {
+        if (lights[l].type != VEIL_LIGHT_DIRECTIONAL) continue;
+        veil_opv_sun* w = &want[count];
+        memset(w, 0, sizeof *w);
+        veil_error ignored;
+        size_t voxels = veil_grid_voxels(g), most = VEIL_SUN_MAX_NODES;
+        if (voxels < most / VEIL_SUN_NODES_PER_VOXEL) most = voxels * VEIL_SUN_NODES_PER_VOXEL;
+        /* the spacing asked for, widened across the light by 5/4 at a time until the grid fits */
+        float across = veil_opv_sun_across(params);
+        veil_result made = VEIL_ERR_LIMIT;
+        for (; made != VEIL_OK && across <= VEIL_SUN_WIDEST; across *= 1.25f)
+            made = veil_sun_space_make(g, lights[l].direction, across, veil_opv_sun_along(params),
+                                       veil_opv_sun_panels(params), max_axis, most, &w->space, &ignored);
+        if (made != VEIL_OK) continue; /* too large a grid even so: this sun stays on the EV's grid */
+        w->light = l;
+        veil_sun_space_to_texture(g, &w->space, w->to_tex);
+        want_key[count] = veil_hash_bytes(veil_hash_bytes(ev_key, params, sizeof *params), &w->space, sizeof w->space);
+        ol[l].elsewhere = 1;
+        ++count;
+    }
+    return count;
+}
+
+/* The light-space grids for the suns among lights[0..n) (veil_opv_plan_suns):
+ * brings their textures up to date. */
+static veil_result update_suns(veil_opv_set* s, const veil_grid* g, GLuint ev, GLuint occ, int count,
+                               const veil_opv_sun* want, const uint64_t* want_key, veil_opv_report* rep,
+                               veil_error* err)
+{
+    /* keep each grid whose key is wanted (in the wanted slot), drop the rest */
+    veil_opv_sun keep[VEIL_MAX_SUNS];
+    uint64_t keep_key[VEIL_MAX_SUNS];
+    memset(keep, 0, sizeof keep);
+    memset(keep_key, 0, sizeof keep_key);
+    for (int k = 0; k < count; ++k)
+        for (int o = 0; o < s->suns; ++o)
+            if (s->sun_key[o] && s->sun_key[o] == want_key[k] && s->sun[o].texture) {
+                keep[k] = s->sun[o];
+                keep_key[k] = want_key[k];
+                s->sun[o].texture = 0;
+                s->sun_key[o] = 0;
+                break;
+            }
+    for (int o = 0; o < VEIL_MAX_SUNS; ++o) drop_sun(s, o);
+    s->suns = count;
+    veil_result r = VEIL_OK;
+    for (int k = 0; k < count; ++k) {
+        if (keep_key[k]) {
+            s->sun[k] = keep[k];
+            s->sun[k].light = want[k].light; /* the same grid may serve a light at another index */
+            s->sun_key[k] = keep_key[k];
+            continue;
+        }
+        s->sun[k] = want[k];
+        if (r == VEIL_OK) r = veil_gl_texture3d(GL_R32F, want[k].space.nodes, "veil light-space optical depth",
+                                                &s->sun[k].texture, err);
+        if (r == VEIL_OK) r = sun_depths(s, g, ev, occ, &want[k].space, s->sun[k].texture, err);
+        if (r == VEIL_OK) s->sun_key[k] = want_key[k];
+        ++rep->suns_computed;
+    }
+    rep->suns = count;
+    for (int k = 0; k < count; ++k) {
+        const float* a = s->sun[k].space.axis[0];
+        float across = sqrtf(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        rep->sun_across = across > rep->sun_across ? across : rep->sun_across;
+    }
+    for (int k = 0; k < count; ++k) rep->mib += (double)veil_sun_space_nodes(&s->sun[k].space) * 4.0 / 1048576.0;
+    return r;
+}
+
+veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, GLuint occ,
+                                const veil_ev_sparse* sp, uint64_t ev_key, const veil_light* lights, int n,
+                                const veil_opv_params* params, veil_opv_report* rep, veil_error* err)
 {
     memset(rep, 0, sizeof *rep);
     veil_result r = VEIL_OK;
     const int report = veil_progress_wanted();
+    veil_opv_light ol[VEIL_MAX_LIGHTS];
+    n = n < VEIL_MAX_LIGHTS ? n : VEIL_MAX_LIGHTS;
+    veil_opv_sun want[VEIL_MAX_SUNS];
+    uint64_t want_key[VEIL_MAX_SUNS];
+    GLint max_axis = 0;
+    glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max_axis);
+    int suns = veil_opv_plan_suns(g, ev_key, lights, n, params, sp ? 0 : max_axis, ol, want, want_key);
+    if (suns > 0) {
+        if (report) veil_progress("optical depth, suns", 0, 1);
+        r = update_suns(s, g, ev, occ, suns, want, want_key, rep, err);
+    } else {
+        for (int k = 0; k < VEIL_MAX_SUNS; ++k) drop_sun(s, k);
+        s->suns = 0;
+    }
     for (int t = 0; 4 * t < n && r == VEIL_OK; ++t) {
         if (report) { /* lights done of all; the textures before this one finished first */
             glFinish();
             veil_progress("optical depth, lights", 4.0 * t, n);
         }
-        int count = n - 4 * t < 4 ? n - 4 * t : 4;
-        veil_opv_light ol[4];
-        for (int c = 0; c < count; ++c) veil_opv_light_from_world(g, &lights[4 * t + c], &ol[c]);
-        uint64_t key = veil_opv_texture_key(ev_key, params, ol, count);
+        int count = n - 4 * t < 4 ? n - 4 * t : 4, on_grid = 0;
+        for (int c = 0; c < count; ++c) on_grid += !ol[4 * t + c].elsewhere;
+        if (!on_grid) { /* every light of this texture has its own grid */
+            glDeleteTextures(1, &s->tex[t]);
+            s->tex[t] = 0;
+            s->key[t] = 0;
+            memset(s->dims[t], 0, sizeof s->dims[t]);
+            continue;
+        }
+        const int* td = sp ? sp->atlas_texels : g->dims;
+        rep->mib += (double)td[0] * td[1] * td[2] * 16.0 / 1048576.0;
+        uint64_t key = veil_opv_texture_key(ev_key, params, ol + 4 * t, count);
         if (veil_opv_set_has(s, t, key)) {
             ++rep->cached;
             continue;
@@ -212,8 +364,8 @@ veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, 
         r = texture_of(s, t, sp ? sp->atlas_texels : g->dims, sp ? "veil optical depth (sparse atlas)" : "veil optical-depth volume", err);
         int it = 0;
         s->key[t] = 0;
-        if (r == VEIL_OK && sp) r = sparse_depths(s, sp, ol, count, s->tex[t], &it, err);
-        else if (r == VEIL_OK) r = veil_opv_gpu(&s->programs, g, ev, ol, count, params, &s->tex[t], &it, err);
+        if (r == VEIL_OK && sp) r = sparse_depths(s, sp, ol + 4 * t, count, s->tex[t], &it, err);
+        else if (r == VEIL_OK) r = veil_opv_gpu(&s->programs, g, ev, ol + 4 * t, count, params, &s->tex[t], &it, err);
         if (r == VEIL_OK) s->key[t] = key;
         rep->iterations = it > rep->iterations ? it : rep->iterations;
         ++rep->computed;
@@ -253,5 +405,56 @@ veil_result veil_opv_set_propagate_readback(veil_opv_set* s, const veil_grid* g,
     glDeleteTextures(1, &ev);
     glDeleteTextures(VEIL_MAX_OPV_TEXTURES, opv);
     free(tmp);
+    return r;
+}
+
+veil_result veil_opv_set_sun_readback(veil_opv_set* s, const veil_grid* g, const float* density,
+                                      const veil_sun_space* space, int occupancy, float* out, veil_error* err)
+{
+    GLuint ev = 0, occ = 0, tex = 0;
+    int bricks[3];
+    for (int a = 0; a < 3; ++a) bricks[a] = (g->dims[a] + VEIL_BRICK - 1) / VEIL_BRICK;
+    size_t nb = (size_t)bricks[0] * bricks[1] * bricks[2];
+    float* bmax = occupancy ? calloc(nb, sizeof *bmax) : NULL;
+    veil_result r = occupancy && !bmax ? veil_fail(err, VEIL_ERR_OOM, "out of memory") : VEIL_OK;
+    if (r == VEIL_OK) r = veil_gl_texture3d(GL_R32F, g->dims, "veil extinction volume", &ev, err);
+    if (r == VEIL_OK) {
+        glTextureSubImage3D(ev, 0, 0, 0, 0, g->dims[0], g->dims[1], g->dims[2], GL_RED, GL_FLOAT, density);
+        r = veil_gl_check("uploading the extinction volume", err);
+    }
+    if (r == VEIL_OK && occupancy) { /* each brick's largest density with the ring around it (occupancy.comp) */
+        for (int k = 0; k < g->dims[2]; ++k)
+            for (int j = 0; j < g->dims[1]; ++j)
+                for (int i = 0; i < g->dims[0]; ++i) {
+                    float v = density[((size_t)k * g->dims[1] + j) * g->dims[0] + i];
+                    const int x[3] = {i, j, k};
+                    int lo[3], hi[3];
+                    for (int a = 0; a < 3; ++a) { /* bricks b with 8b - 1 <= x <= 8b + 8 */
+                        lo[a] = (x[a] + VEIL_BRICK - 1) / VEIL_BRICK - 1;
+                        lo[a] = lo[a] < 0 ? 0 : lo[a];
+                        hi[a] = (x[a] + 1) / VEIL_BRICK;
+                        hi[a] = hi[a] > bricks[a] - 1 ? bricks[a] - 1 : hi[a];
+                    }
+                    for (int c = lo[2]; c <= hi[2]; ++c)
+                        for (int b = lo[1]; b <= hi[1]; ++b)
+                            for (int a = lo[0]; a <= hi[0]; ++a) {
+                                float* m = &bmax[((size_t)c * bricks[1] + b) * bricks[0] + a];
+                                *m = v > *m ? v : *m;
+                            }
+                }
+        r = veil_gl_texture3d(GL_R32F, bricks, "veil occupancy", &occ, err);
+        if (r == VEIL_OK) {
+            glTextureSubImage3D(occ, 0, 0, 0, 0, bricks[0], bricks[1], bricks[2], GL_RED, GL_FLOAT, bmax);
+            r = veil_gl_check("uploading the occupancy", err);
+        }
+    }
+    if (r == VEIL_OK) r = veil_gl_texture3d(GL_R32F, space->nodes, "veil light-space optical depth", &tex, err);
+    if (r == VEIL_OK) r = sun_depths(s, g, ev, occ, space, tex, err);
+    if (r == VEIL_OK)
+        r = veil_gl_read_texture(tex, GL_RED, veil_sun_space_nodes(space), out, "reading back a light-space grid", err);
+    glDeleteTextures(1, &ev);
+    glDeleteTextures(1, &occ);
+    glDeleteTextures(1, &tex);
+    free(bmax);
     return r;
 }

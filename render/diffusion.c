@@ -226,7 +226,7 @@ veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, 
     glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, d->march_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_DIFFUSION, d->ubo);
     glBindTextureUnit(VEIL_TEX_EV, md->grid ? md->ev : 0);
-    for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, md->opv ? md->opv[t] : 0);
+    veil_march_bind_depths(md);
     if (escape) {
         glUseProgram(d->escape_program);
         glBindImageTexture(VEIL_IMAGE_DIFF_PHI, d->phi, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
@@ -254,6 +254,7 @@ veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, 
     glBindImageTexture(VEIL_IMAGE_DIFF_SRC, 0, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     glBindImageTexture(VEIL_IMAGE_DIFF_PHI, 0, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     for (int t = 0; t <= VEIL_TEX_OPV0 + VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit((GLuint)t, 0);
+    if (!md->sparse) veil_march_bind_depths(NULL);
     glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, 0);
     glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_DIFFUSION, 0);
     glUseProgram(0);

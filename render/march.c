@@ -111,6 +111,17 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
     u->limits[1] = d->grid != NULL && d->emission ? 1.0f : 0.0f;
     u->flags[2] = d->seed;
     u->flags[3] = d->end_distance != NULL;
+    for (int k = 0; d->grid && !d->sparse && k < d->sun_count && k < VEIL_MAX_SUNS; ++k) {
+        int l = d->suns[k].light;
+        if (l < 0 || l >= n) continue;
+        u->sun_of[l / 4][l % 4] = k + 1;
+        for (int row = 0; row < 3; ++row) memcpy(u->sun_map[3 * k + row], d->suns[k].to_tex[row], sizeof u->sun_map[0]);
+        const float* c = d->suns[k].space.axis[2];
+        float along = sqrtf(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+        u->sun_step[k][0] = along * d->grid->voxel;
+        u->sun_step[k][1] = (float)d->suns[k].space.nodes[2];
+        u->sun_step[k][2] = ceilf(along); /* pieces of at most a voxel, as the prefix sum's panels */
+    }
     const veil_multiple* ms = &d->scene->multiple;
     if (d->diffusion && d->diffusion->texture) {
         set3(u->diffusion, d->diffusion->tex_min, d->diffusion->kind);
@@ -121,6 +132,14 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
         u->octave[3] = (float)ms->octaves;
     }
     return VEIL_OK;
+}
+
+void veil_march_bind_depths(const veil_march_desc* d)
+{
+    for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, d && d->opv ? d->opv[t] : 0);
+    if (d && d->sparse) return; /* the sparse tables hold these units */
+    for (int k = 0; k < VEIL_MAX_SUNS; ++k)
+        glBindTextureUnit(VEIL_TEX_SUN0 + k, d && d->grid && k < d->sun_count ? d->suns[k].texture : 0);
 }
 
 static veil_result image(int w, int h, const char* label, GLuint* tex, veil_error* err)
@@ -197,7 +216,7 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, m->ubo);
         glBindTextureUnit(VEIL_TEX_EV, d->grid ? d->ev : 0);
         glBindTextureUnit(VEIL_TEX_OCC, d->grid ? d->occupancy : 0);
-        for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, d->opv ? d->opv[t] : 0);
+        veil_march_bind_depths(d);
         glBindTextureUnit(VEIL_TEX_LIMIT, limit);
         glBindTextureUnit(VEIL_TEX_DIFFUSION, d->diffusion ? d->diffusion->texture : 0);
         glBindTextureUnit(VEIL_TEX_EMISSION, d->grid ? d->emission : 0);
@@ -221,6 +240,7 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         for (int t = 0; t <= VEIL_TEX_EMISSION; ++t) glBindTextureUnit((GLuint)t, 0);
+        if (!(d->grid && d->sparse)) veil_march_bind_depths(NULL);
         veil_ev_sparse_bind(NULL);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, 0);
         glUseProgram(0);

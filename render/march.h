@@ -14,6 +14,7 @@
 #include <stdint.h>
 
 #include "../core/result.h"
+#include "../propagate/opv_set.h"
 #include "../scene/scene.h"
 #include "../volume/ev.h"
 #include "../volume/volume.h"
@@ -61,6 +62,8 @@ typedef struct veil_march_desc {
                                      the escape field are atlases too); NULL: dense */
     GLuint emission;           /* the EV's emission texture (0: none) */
     const GLuint* opv;         /* VEIL_MAX_OPV_TEXTURES textures (0 where unused) */
+    const veil_opv_sun* suns;  /* light-space grids of suns (propagate/opv_set.h), dense volumes only */
+    int sun_count;
     float step_voxels;         /* > 0 */
     uint32_t seed;             /* jitter seed */
     int skip_empty;            /* 1: jump over bricks without density (when there is no fog) */
@@ -85,6 +88,10 @@ int veil_march_band_rows(const veil_march_desc* d, int w, int h);
 
 /* Tests: the work budget of a band (0: VEIL_MARCH_DISPATCH_WORK again). */
 void veil_march_set_dispatch_work(uint64_t work);
+
+/* Binds d's optical depths (OPV textures and light-space grids) for a pass
+ * that reads render/shaders/medium_common.glsl; 0 unbinds them. */
+void veil_march_bind_depths(const veil_march_desc* d);
 
 /* One light in the GPU's shape. */
 void veil_gpu_light_from(const veil_light* l, veil_gpu_light* out);

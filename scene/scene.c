@@ -118,3 +118,20 @@ void veil_multiple_defaults(veil_multiple* m)
     m->octave_c = 0.7f;
     m->octave_gate = VEIL_GATE_ESCAPE;
 }
+
+static const char* const quality_names[VEIL_QUALITY_COUNT] = {NULL, "draft", "default", "high", "max"};
+
+const char* veil_quality_name(veil_quality q)
+{
+    return (unsigned)q < VEIL_QUALITY_COUNT ? quality_names[q] : NULL;
+}
+
+int veil_quality_parse(const char* name, veil_quality* out)
+{
+    for (int q = 1; q < VEIL_QUALITY_COUNT; ++q)
+        if (!strcmp(name, quality_names[q])) {
+            *out = (veil_quality)q;
+            return 1;
+        }
+    return 0;
+}

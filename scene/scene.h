@@ -205,6 +205,21 @@ void veil_spread_default_weights(veil_spread_filter f, float w[6]);
 /* Taps of filter f: 2, 4 or 6. */
 int veil_spread_taps(veil_spread_filter f);
 
+/* The quality ladder (frame/renderer.h says what each rung sets). */
+typedef enum veil_quality {
+    VEIL_QUALITY_UNSET = 0, /* the scene's, else VEIL_QUALITY_DEFAULT */
+    VEIL_QUALITY_DRAFT,
+    VEIL_QUALITY_DEFAULT,
+    VEIL_QUALITY_HIGH,
+    VEIL_QUALITY_MAX,
+    VEIL_QUALITY_COUNT
+} veil_quality;
+
+/* "draft", "default", "high", "max" (NULL for anything else) */
+const char* veil_quality_name(veil_quality q);
+/* 1 on success */
+int veil_quality_parse(const char* name, veil_quality* out);
+
 typedef struct veil_scene {
     char* path;     /* the file as given (owned) */
     char* base_dir; /* its folder, for relative paths (owned) */
@@ -214,6 +229,7 @@ typedef struct veil_scene {
     size_t light_count;
     float background[3]; /* linear RGB radiance seen through the medium */
     veil_multiple multiple;
+    veil_quality quality; /* "quality": UNSET when absent */
 } veil_scene;
 
 void veil_scene_free(veil_scene* s); /* accepts NULL and zeroed scenes */

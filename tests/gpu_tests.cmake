@@ -1,6 +1,7 @@
 veil_test(test_gpu_context SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_gpu_context.c LABELS gpu)
 veil_test(test_inject_gpu SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_inject_gpu.c LABELS gpu)
 veil_test(test_propagate_gpu SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_propagate_gpu.c LABELS gpu)
+veil_test(test_sun_space_gpu SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_sun_space_gpu.c LABELS gpu)
 veil_test(test_single_scatter SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_single_scatter.c LABELS "gpu;accuracy")
 
 # End to end through the CLI: the demo scene at a small size, gpuinfo, usage.

@@ -10,6 +10,7 @@ layout(std140, binding = VEIL_UBO_MARCH) uniform veil_march_ubo { veil_march_blo
 //@include volume/shaders/sparse_common.glsl
 #else
 layout(binding = VEIL_TEX_EV) uniform sampler3D u_ev;
+layout(binding = VEIL_TEX_SUN0) uniform sampler3D u_sun[VEIL_MAX_SUNS]; // suns' light-space grids
 #endif
 
 // The EV's density at x (inside its box).
@@ -57,6 +58,29 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
     vec2 s = box_hit(x, to, u.box_min.xyz, u.box_max.xyz, 0.0, len);
     if (s.x > s.y) return 0.0;
     vec3 y = x + to * s.x;
+    int k = u.sun_of[l / 4][l % 4] - 1;
+    if (k >= 0) { // a sun in its light-space grid (propagate/sun_space.h)
+        // D at the node plane just towards the light (exact along the light:
+        // no interpolation between planes there) plus the density over the
+        // last stretch, midpoint rule in sun_step.z pieces: linear
+        // interpolation between planes over-darkened the lit faces, where D
+        // rises from 0 within a node spacing
+        vec4 p = vec4(y, 1.0);
+        vec3 q = vec3(dot(u.sun_map[3 * k], p), dot(u.sun_map[3 * k + 1], p), dot(u.sun_map[3 * k + 2], p));
+        float c = q.z * u.sun_step[k].y - 0.5;
+        float c0 = max(floor(c), 0.0);
+        float back = (c - c0) * u.sun_step[k].x; // m to the plane, towards the light
+        q.z = (c0 + 0.5) / u.sun_step[k].y;
+        float D = texture(u_sun[k], q).r;
+        int n = int(u.sun_step[k].z);
+        float piece = back / float(n);
+        for (int i = 0; i < n; ++i) {
+            vec3 m = y + to * (piece * (float(i) + 0.5));
+            if (all(greaterThanEqual(m, u.box_min.xyz)) && all(lessThanEqual(m, u.box_max.xyz)))
+                D += ev_density(m) * piece;
+        }
+        return D;
+    }
     return texture(u_opv[l / 4], (y - u.tex_min.xyz) * u.tex_inv_size.xyz)[l % 4];
 #endif
 }
