@@ -5,6 +5,9 @@
 #   make data   generate the VDBs that data/scenes/vdb_smoke.json and pyro.json render
 #   make accuracy  time against error of the GPU path vs the CPU reference
 #                  (bench/accuracy --quick, under 2 minutes; FULL=1: the full sweep)
+#   make peers  veil against OpenVDB's vdb_render, time against error on three VDBs
+#               (bench/peers.py: installs libopenvdb-tools and gnuplot; ~30 minutes the
+#               first time, the references then cached; PEERS_ARGS="--quick": minutes)
 #   make fuzz   libFuzzer on the scene parser, the particle readers, the EXR and
 #               the OpenVDB readers, FUZZ_SECONDS each (default 60), under ASan and
 #               UBSan, in build-fuzz/ (scripts/fuzz.sh)
@@ -15,7 +18,7 @@
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
-.PHONY: all deps build demo test data clean accuracy test-sanitize fuzz
+.PHONY: all deps build demo test data clean accuracy test-sanitize fuzz peers
 FUZZ_SECONDS ?= 60
 
 all: build
@@ -54,6 +57,12 @@ accuracy:
 	@$(MAKE) --no-print-directory build
 	@test -f data/generated/smoke_plume.vdb || $(MAKE) --no-print-directory data
 	@$(BUILD)/bench/accuracy $(if $(FULL),,--quick) $(ACCURACY_ARGS)
+
+peers:
+	@$(MAKE) --no-print-directory deps
+	@bash scripts/install-bench-deps.sh libopenvdb-tools gnuplot-nox
+	@$(MAKE) --no-print-directory build
+	@python3 bench/peers.py $(PEERS_ARGS)
 
 test-sanitize:
 	@$(MAKE) --no-print-directory deps

@@ -103,10 +103,11 @@ static void add_point(point* p, int* n, int default_res, float step, int res, ve
  * seconds a light at 128^3 on llvmpipe) only on coarse grids. */
 static int make_points(int default_res, int quick, point* p)
 {
-    const veil_opv_method SL = VEIL_OPV_SEMI_LAGRANGIAN;
+    const veil_opv_method SL = VEIL_OPV_DEFAULT_METHOD; /* light-space: suns in their grids, the rest semi-Lagrangian */
     const float d = VEIL_DEFAULT_STEP_VOXELS;
     int n = 0;
     add_point(p, &n, default_res, d, default_res, SL);
+    add_point(p, &n, default_res, d, default_res, VEIL_OPV_SEMI_LAGRANGIAN); /* the default before issue 13 */
     static const float steps_full[] = {16, 8, 4, 2, 1, 0.25f, 0.125f}, steps_quick[] = {4, 1, 0.25f};
     static const int res_full[] = {32, 64, 128, 256}, res_quick[] = {32, 64};
     const float* steps = quick ? steps_quick : steps_full;

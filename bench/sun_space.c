@@ -89,6 +89,14 @@ static double lookup(const veil_grid* g, const float* rho, const veil_sun_space*
         double w = (corner & 1 ? f[0] : 1 - f[0]) * (corner & 2 ? f[1] : 1 - f[1]);
         sum += w * D[((size_t)k * s->nodes[1] + iy) * s->nodes[0] + ix];
     }
+    /* the stretch's part in the medium's box, as the shader clips it */
+    float blo[3], bhi[3];
+    veil_grid_medium_box(g, blo, bhi);
+    for (int a = 0; a < 3; ++a)
+        if (travel[a] != 0.0f) {
+            double exit = ((travel[a] < 0 ? bhi[a] : blo[a]) - x[a]) / -travel[a];
+            back = exit < back ? (exit > 0 ? exit : 0) : back;
+        }
     int pieces = (int)ceil(along);
     double piece = back / pieces;
     for (int p = 0; p < pieces; ++p) {

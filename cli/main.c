@@ -1,8 +1,8 @@
 /* veil — the command-line tool.
  *
  *   veil render SCENE.json -o OUT.exr [--png OUT.png] [--width W] [--height H]
- *               [--step S] [--seed N] [--method M] [--turntable N] [--aovs] [--stats]
- *               [--explain]
+ *               [--quality Q] [--step S] [--od-spacing A[,B]] [--seed N] [--method M]
+ *               [--turntable N] [--aovs] [--stats] [--explain]
  *   veil gpuinfo
  *   veil info FILE.vdb [--json]
  *   veil rbf generate -o OUT --count N --seed S --bounds x0,y0,z0,x1,y1,z1
@@ -23,8 +23,8 @@
 
 static const char* usage_text =
     "usage: veil render SCENE.json -o OUT.exr [--png OUT.png] [--width W] [--height H]\n"
-    "                   [--step S] [--seed N] [--method M] [--turntable N] [--aovs]\n"
-    "                   [--stats] [--explain]\n"
+    "                   [--quality Q] [--step S] [--od-spacing A[,B]] [--seed N] [--method M]\n"
+    "                   [--turntable N] [--aovs] [--stats] [--explain]\n"
     "       veil reference SCENE.json -o REF.exr --spp N [--max-order K] [--width W]\n"
     "                [--height H] [--seed N] [--threads T] [--light-sampling distance|mis]\n"
     "       veil compare A.exr REF.exr [--heatmap OUT.png] [--floor F] [--bin B] [--json]\n"
@@ -42,10 +42,17 @@ static const char* usage_text =
     "  -o OUT.exr     output EXR (required)\n"
     "  --png OUT.png  also write a preview PNG\n"
     "  --width W, --height H  override the scene camera's image size (1..16384)\n"
-    "  --step S       ray-march step in voxels (default 0.5)\n"
+    "  --quality Q    draft, default, high or max (else the scene's \"quality\"): the march\n"
+    "                 step, the optical-depth method and its grids' spacing together\n"
+    "                 (docs/performance.md has each rung's time and error)\n"
+    "  --step S       ray-march step in voxels (default: the rung's, 0.5 at default)\n"
     "  --seed N       jitter seed (default 0)\n"
-    "  --method M     optical-depth propagation: semi-lagrangian (default), sweep,\n"
-    "                 jacobi-corrected, jacobi (the published scheme)\n"
+    "  --method M     optical-depth propagation: light-space (the default: suns in grids\n"
+    "                 aligned with them, one prefix sum a column; other lights as\n"
+    "                 semi-lagrangian), semi-lagrangian, sweep, jacobi-corrected,\n"
+    "                 jacobi (the published scheme)\n"
+    "  --od-spacing A[,B]  light-space grids: nodes A voxels apart across the light and\n"
+    "                 B along it (default: the rung's, 0.5,4 at default; B = A if left out)\n"
     "  --turntable N  N frames with the camera orbiting the look-at point about the\n"
     "                 up axis, written as OUT_0000.exr ... (volume and optical depth\n"
     "                 are computed once and reused: see --stats)\n"

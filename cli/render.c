@@ -58,11 +58,17 @@ static int parse_render_args(int argc, char** argv, render_args* a)
             if (!veil_quality_parse(v, &a->quality))
                 return veil_cli_usage_error("--quality: expected draft, default, high or max, got '%s'", v);
         } else if (!strcmp(s, "--od-spacing")) {
-            char extra;
-            int n = sscanf(v, "%f,%f%c", &a->sun_across, &a->sun_along, &extra);
-            if (n == 1) a->sun_along = a->sun_across;
-            if ((n != 1 && n != 2) || !(a->sun_across >= 0.1f && a->sun_across <= 16.0f) ||
-                !(a->sun_along >= 0.1f && a->sun_along <= 16.0f))
+            char across[64];
+            const char* comma = strchr(v, ',');
+            size_t n = comma ? (size_t)(comma - v) : strlen(v);
+            int ok = n < sizeof across;
+            if (ok) {
+                memcpy(across, v, n);
+                across[n] = '\0';
+                ok = veil_cli_parse_float(across, 0.1f, 16.0f, &a->sun_across) &&
+                     veil_cli_parse_float(comma ? comma + 1 : across, 0.1f, 16.0f, &a->sun_along);
+            }
+            if (!ok)
                 return veil_cli_usage_error("--od-spacing: expected ACROSS[,ALONG] in voxels, each in 0.1..16, got '%s'", v);
         } else if (s[0] == '-' && s[1]) return veil_cli_usage_error("unknown option '%s'", s);
         else if (!a->scene) { a->scene = s; continue; }

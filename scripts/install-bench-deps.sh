@@ -2,7 +2,8 @@
 # Installs the Debian 12 packages the benchmarks and tools need beyond
 # scripts/install-deps.sh: by default gnuplot (no X11) for bench/accuracy's
 # time-error plot; with arguments, those packages instead (`make fuzz`:
-# clang, whose libFuzzer tests/fuzz/ needs). Idempotent: silent when
+# clang, whose libFuzzer tests/fuzz/ needs; `make peers`: libopenvdb-tools,
+# OpenVDB's vdb_render and vdb_tool, which bench/peers.py measures against). Idempotent: silent when
 # everything is present. Run by a user who is not root, it prints the exact
 # command to run and stops.
 set -euo pipefail

@@ -21,6 +21,18 @@ fail() { echo "FAIL: $*"; exit 1; }
 "$veil" render "$scene" -o "$tmp/no/such/dir/x.exr" 2> "$tmp/nodir.err"; [ $? -eq 1 ] || fail "missing output folder must exit 1"
 grep -q "the folder '$tmp/no/such/dir' does not exist" "$tmp/nodir.err" || fail "missing folder message: $(cat "$tmp/nodir.err")"
 "$veil" frobnicate 2>/dev/null; [ $? -eq 2 ] || fail "unknown command must exit 2"
+# the quality ladder and the light-space spacing: bad values refused, good ones in the plan (no GPU)
+for bad in "--quality best" "--od-spacing 0" "--od-spacing 1,2,3" "--od-spacing nan" "--od-spacing 0.5,x"; do
+  "$veil" render "$scene" -o "$tmp/x.exr" $bad 2> "$tmp/usage.err"; [ $? -eq 2 ] || fail "'$bad' must exit 2"
+  grep -q -- "${bad%% *}" "$tmp/usage.err" || fail "'$bad': the message does not name the option: $(cat "$tmp/usage.err")"
+done
+"$veil" render "$scene" --explain --quality draft | grep -q 'quality draft, step 1 voxels' || fail "draft's step"
+"$veil" render "$scene" --explain --quality high > "$tmp/high.txt"
+grep -q 'quality high, step 0.5 voxels' "$tmp/high.txt" && grep -q 'light-space grid .* 0.35 voxels apart across' "$tmp/high.txt" ||
+  fail "high's step and spacing: $(cat "$tmp/high.txt")"
+"$veil" render "$scene" --explain --quality max --step 2 --od-spacing 0.8,3 > "$tmp/knobs.txt"
+grep -q 'quality max, step 2 voxels' "$tmp/knobs.txt" && grep -q '0.8 voxels apart across' "$tmp/knobs.txt" ||
+  fail "--step and --od-spacing do not override the rung: $(cat "$tmp/knobs.txt")"
 
 # The value checker checks: it passes a good EXR and fails (exit 1) on each
 # kind of bad value. No GPU needed.

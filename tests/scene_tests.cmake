@@ -25,6 +25,7 @@ veil_bad_input(missing_field ${BAD}/missing_field.json
 veil_bad_input(negative_resolution ${BAD}/negative_resolution.json
                "medium.max_resolution: expected an integer in [2, 2048], got -16 (negative and zero values are not allowed)")
 veil_bad_input(bad_phase_type ${BAD}/bad_phase_type.json "medium.phase.type: expected one of")
+veil_bad_input(bad_quality ${BAD}/bad_quality.json "bad_quality.json: quality: expected one of \"draft\", \"default\", \"high\", \"max\", got a string (\"best\")")
 veil_bad_input(g_out_of_range ${BAD}/g_out_of_range.json "medium.phase.g: expected a number in (-1, 1), got 1.5")
 veil_bad_input(zero_direction ${BAD}/zero_direction.json "lights[0].direction: expected a non-zero vector")
 veil_bad_input(bad_sharpness ${BAD}/bad_sharpness.json

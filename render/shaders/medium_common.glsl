@@ -62,7 +62,7 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
     if (k >= 0) { // a sun in its light-space grid (propagate/sun_space.h)
         // D at the node plane just towards the light (exact along the light:
         // no interpolation between planes there) plus the density over the
-        // last stretch, midpoint rule in sun_step.z pieces: linear
+        // last stretch, midpoint rule in sun_step.z pieces of at most a voxel: linear
         // interpolation between planes over-darkened the lit faces, where D
         // rises from 0 within a node spacing
         vec4 p = vec4(y, 1.0);
@@ -72,13 +72,12 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
         float back = (c - c0) * u.sun_step[k].x; // m to the plane, towards the light
         q.z = (c0 + 0.5) / u.sun_step[k].y;
         float D = texture(u_sun[k], q).r;
+        // the stretch's part in the box (the medium ends at its faces: a piece across one would
+        // count density beyond it)
+        back = min(back, box_hit(y, to, u.box_min.xyz, u.box_max.xyz, 0.0, INF).y);
         int n = int(u.sun_step[k].z);
         float piece = back / float(n);
-        for (int i = 0; i < n; ++i) {
-            vec3 m = y + to * (piece * (float(i) + 0.5));
-            if (all(greaterThanEqual(m, u.box_min.xyz)) && all(lessThanEqual(m, u.box_max.xyz)))
-                D += ev_density(m) * piece;
-        }
+        for (int i = 0; i < n && back > 0.0; ++i) D += ev_density(y + to * (piece * (float(i) + 0.5))) * piece;
         return D;
     }
     return texture(u_opv[l / 4], (y - u.tex_min.xyz) * u.tex_inv_size.xyz)[l % 4];
