@@ -152,7 +152,8 @@ void acc_print_pareto_tables(const acc_row* rows, size_t n, const char* const* s
 
 void acc_print_summary(const acc_row* rows, size_t n, const char* const* scenes, int n_scenes)
 {
-    acc_out("\n### The default setting (step 0.5 voxel, the scene's max_resolution, semi-lagrangian)\n\n");
+    acc_out("\n### The default setting (step 0.5 voxel, the scene's max_resolution, %s)\n\n",
+            veil_opv_method_name(VEIL_OPV_DEFAULT_METHOD));
     acc_out("| scene | grid | time (ms) | CPU (ms) | rel. RMSE | ref. noise | excess | rel. RMSE %dx%d | its noise | "
             "excess |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
             ACC_BIN, ACC_BIN);

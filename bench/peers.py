@@ -9,7 +9,9 @@ against `veil reference` single scattering.
 Scenes (240x320 pixels, one sun, isotropic phase, black background):
 - smoke: ../shared/data/smoke.vdb (skipped when absent);
 - sphere: a fog sphere made by OpenVDB's own vdb_tool (-sphere -ls2fog);
-- plume: the noise plume of tests/make_test_vdbs --plume.
+- plume: the noise plume of tests/make_test_vdbs, faded out at its bottom
+  and top (--plume-faded): cut through, its dense faces are a place where
+  the two tools' media differ (docs/peers.md).
 
 How one scene maps onto the other (docs/peers.md says why, and which of
 these a run confirmed):
@@ -97,9 +99,9 @@ def make_scenes(a):
                  "-write", sphere])
         out.append(("sphere", sphere, 0.04, 0.004))
     if "plume" in want:
-        plume = os.path.join(CACHE, "noise_plume.vdb")
-        if not os.path.exists(plume):
-            run([os.path.join(BUILD, "tests", "make_test_vdbs"), "--plume", plume])
+        plume = os.path.join(CACHE, "noise_plume_faded.vdb")
+        if not os.path.exists(plume):  # faded at the bottom and top: no face cuts dense smoke (docs/peers.md)
+            run([os.path.join(BUILD, "tests", "make_test_vdbs"), "--plume-faded", plume])
         out.append(("plume", plume, 0.06, 0.003))
     return out
 
@@ -191,6 +193,7 @@ def main():
     ap.add_argument("--quick", action="store_true", help="1 run, 2048 spp, no finest vdb_render setting")
     ap.add_argument("--knobs", action="store_true",
                     help="veil alone: the march step and the light-space spacing one at a time (OUT/peers-knobs.md)")
+    ap.add_argument("--replot", action="store_true", help="rewrite peers.md and peers.png from peers.csv")
     ap.add_argument("--veil", default=os.path.join(BUILD, "veil"))
     ap.add_argument("--ref-veil", default=None,
                     help="the veil that renders (and keys) the references; default --veil")
@@ -203,6 +206,14 @@ def main():
     vdb_settings = VDB_SETTINGS[:-1] if a.quick else VDB_SETTINGS
     if a.knobs:
         return knobs(a)
+    if a.replot:  # the tables and the plot again from OUT/peers.csv, nothing run
+        with open(os.path.join(a.out, "peers.csv")) as f:
+            rows = list(csv.DictReader(f))
+        for r in rows:
+            for k in ("time_s", "error", "error_raw", "noise", "bias", "vdb_render_s", "ratio"):
+                if r.get(k):
+                    r[k] = float(r[k])
+        return write(a, rows)
     rows = []
     for name, path, scatter, absorb in make_scenes(a):
         scene_path, vr_args = setup(a, name, path, scatter, absorb)
@@ -304,20 +315,22 @@ def write(a, rows):
                 for tool in ("veil", "vdb_render"):
                     for r in sorted((r for r in rows if r["scene"] == name and r["tool"] == tool),
                                     key=lambda r: r["time_s"]):
-                        if not r["setting"].startswith("semi"):
-                            f.write("%g %g\n" % (r["time_s"], max(100 * r["error"], 0.01)))
+                        if not r["setting"].startswith("semi"):  # the bound: never 0, whatever the noise
+                            f.write("%g %g\n" % (r["time_s"], 100 * r["error_raw"]))
                     f.write("\n\n")
         plots = []
         for i, name in enumerate(scenes):
-            plots.append("'%s' index %d with linespoints lw 2 pt 7 title 'veil, %s'" % (data, 2 * i, name))
-            plots.append("'%s' index %d with linespoints lw 2 pt 5 dt 2 title 'vdb\\_render, %s'" % (data, 2 * i + 1,
-                                                                                                  name))
+            dat = os.path.basename(data)  # gnuplot runs in OUT: the files name each other by their names
+            plots.append("'%s' index %d with linespoints lw 2 pt 7 title 'veil, %s'" % (dat, 2 * i, name))
+            plots.append("'%s' index %d with linespoints lw 2 pt 5 dt 2 title 'vdb\\_render, %s'" % (dat, 2 * i + 1,
+                                                                                                 name))
         gp = ("set terminal pngcairo size 900,600\nset output '%s.png'\nset logscale xy\nset grid\n"
-              "set xlabel 'whole-process time (s), 2 cores, llvmpipe'\nset ylabel 'error vs veil reference (%%)'\n"
-              "set key outside right\nplot %s\n" % (base, ", ".join(plots)))
+              "set xlabel 'whole-process time (s), 2 cores, llvmpipe'\n"
+              "set ylabel 'rel. RMSE of %dx%d means vs reference, noise in (%%)'\n"
+              "set key outside right\nplot %s\n" % (os.path.basename(base), a.bin, a.bin, ", ".join(plots)))
         with open(base + ".gp", "w") as f:
             f.write(gp)
-        subprocess.run(["gnuplot", base + ".gp"], check=False)
+        subprocess.run(["gnuplot", os.path.basename(base) + ".gp"], cwd=a.out, check=False)
 
 
 if __name__ == "__main__":

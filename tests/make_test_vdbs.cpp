@@ -4,6 +4,7 @@
 //   make_test_vdbs DIR           the test files (below), deterministic
 //   make_test_vdbs DIR --big     also big_plume.vdb (~10^6 active voxels, for timing)
 //   make_test_vdbs --plume FILE  only the plume, at the size of big_plume.vdb, into FILE
+//   make_test_vdbs --plume-faded FILE  the same, faded out at its bottom and top (bench/peers.py)
 //   make_test_vdbs --pyro FILE   the base-size plume with a "temperature" grid (0..1), into FILE
 //   make_test_vdbs --pair A B    two overlapping plumes for a two-source scene (bench/vdb_import.py):
 //                                A the base plume (voxel 0.02 m), B a smaller one (voxel 0.03 m,
@@ -47,6 +48,7 @@
 #include <nanovdb/util/IO.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -119,7 +121,12 @@ double value_noise(double x, double y, double z, uint32_t seed)
 // voxels, radius 10 s at the bottom to 25 s at the top, drifting in x),
 // whose density is a radial fall-off times three octaves of value noise;
 // voxels below 0.05 are left inactive (a hard edge, as smoke caches have).
-FloatGrid::Ptr plume(double s)
+// `faded`: the density also fades to nothing over the lowest and highest
+// tenth of the height, so no face of the bounding box cuts through dense
+// smoke (bench/peers.py: OpenVDB's samplers ramp a cut face's density to
+// the background over one more voxel, veil's medium ends at the last
+// voxel centre: docs/peers.md).
+FloatGrid::Ptr plume(double s, bool faded = false)
 {
     FloatGrid::Ptr g = float_grid("density", 0.02);
     FloatGrid::Accessor acc = g->getAccessor();
@@ -137,6 +144,10 @@ FloatGrid::Ptr plume(double s)
                 for (int o = 0; o < 3; ++o, amp *= 0.5, f *= 2.0)
                     n += amp * value_noise(x * f, y * f, z * f, 17u + (uint32_t)o);
                 double v = (1.0 - d * d) * (0.3 + 1.4 * n) * (1.0 - 0.5 * t);
+                if (faded) {
+                    double u = std::min(1.0, std::min(t, 1.0 - t) / 0.1);
+                    v *= u * u * (3 - 2 * u);
+                }
                 if (v > cutoff) acc.setValue(Coord(x, y, z), (float)v);
             }
     }
@@ -531,13 +542,15 @@ void tree_files()
 
 int main(int argc, char** argv)
 {
-    if (argc == 3 && (std::strcmp(argv[1], "--plume") == 0 || std::strcmp(argv[1], "--pyro") == 0)) {
+    if (argc == 3 && (std::strcmp(argv[1], "--plume") == 0 || std::strcmp(argv[1], "--pyro") == 0 ||
+                      std::strcmp(argv[1], "--plume-faded") == 0)) {
         std::filesystem::path file(argv[2]);
         g_dir = file.has_parent_path() ? file.parent_path().string() : std::string(".");
         try {
             std::filesystem::create_directories(g_dir);
             openvdb::initialize();
-            FloatGrid::Ptr p = plume(std::strcmp(argv[1], "--pyro") == 0 ? 1.0 : 2.2);
+            FloatGrid::Ptr p = plume(std::strcmp(argv[1], "--pyro") == 0 ? 1.0 : 2.2,
+                                     std::strcmp(argv[1], "--plume-faded") == 0);
             if (std::strcmp(argv[1], "--pyro") == 0) write(file.filename().string().c_str(), {p, plume_temperature(*p)});
             else write(file.filename().string().c_str(), {p});
         } catch (const std::exception& e) {
@@ -567,7 +580,7 @@ int main(int argc, char** argv)
         return 0;
     }
     if (argc < 2 || argc > 3 || (argc == 3 && std::strcmp(argv[2], "--big") != 0)) {
-        std::fprintf(stderr, "usage: %s DIR [--big] | --plume FILE | --pyro FILE | --pair A B\n", argv[0]);
+        std::fprintf(stderr, "usage: %s DIR [--big] | --plume FILE | --plume-faded FILE | --pyro FILE | --pair A B\n", argv[0]);
         return 2;
     }
     g_dir = argv[1];
