@@ -130,7 +130,7 @@ veil_result veil_plan_explain(const veil_scene* s, const veil_render_opts* opts,
     } else if (n == 0) {
         put(&t, "propagate  skipped on every frame: no light reaches the medium\n");
     } else {
-        veil_opv_params params = veil_render_opv_params(s, &o);
+        veil_opv_params params = veil_render_opv_params(s, &o, NULL, 0); /* no device here: no memory budget */
         veil_opv_light ol[VEIL_MAX_LIGHTS];
         veil_opv_sun suns[VEIL_MAX_SUNS];
         uint64_t sun_keys[VEIL_MAX_SUNS];

@@ -205,7 +205,8 @@ const veil_quality_rung* veil_quality_rung_of(veil_quality q)
     return &rungs[q > VEIL_QUALITY_UNSET && q < VEIL_QUALITY_COUNT ? q : VEIL_QUALITY_DEFAULT];
 }
 
-veil_opv_params veil_render_opv_params(const veil_scene* s, const veil_render_opts* o)
+veil_opv_params veil_render_opv_params(const veil_scene* s, const veil_render_opts* o, const veil_grid* g,
+                                       unsigned long long budget)
 {
     float st_max = 0.0f;
     for (int c = 0; c < 3; ++c) st_max = fmaxf(st_max, s->medium.sigma_a[c] + s->medium.sigma_s[c]);
@@ -213,6 +214,14 @@ veil_opv_params veil_render_opv_params(const veil_scene* s, const veil_render_op
     veil_opv_params p = {.method = veil_opv_method_resolve(o->method),
                          .tolerance = st_max > 0.0f ? VEIL_OPV_TAU_TOLERANCE / st_max : INFINITY,
                          .sun_across = o->sun_across, .sun_along = o->sun_along};
+    if (g && budget > 0) {
+        /* what the device's budget leaves the suns' grids beside the EV and the rgba32f optical depths
+         * veil_ev_check_budget counted (one per four lights, and one more) */
+        double voxels = (double)g->dims[0] * g->dims[1] * g->dims[2];
+        int n = (int)s->light_count < VEIL_MAX_LIGHTS ? (int)s->light_count : VEIL_MAX_LIGHTS;
+        double used = voxels * 4.0 + voxels * 16.0 * ((n + 3) / 4 + 1);
+        p.sun_bytes = (double)budget > used ? (double)budget - used : 1.0;
+    }
     return p;
 }
 
@@ -231,7 +240,7 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
         why(rep, "no light reaches the medium (of %zu)", s->light_count);
         return VEIL_OK;
     }
-    veil_opv_params params = veil_render_opv_params(s, o);
+    veil_opv_params params = veil_render_opv_params(s, o, g, r->memory_budget);
     veil_opv_report orep = {0};
     const veil_ev_sparse* sp = veil_ev_sparse_of(r->ev);
     veil_result res = veil_opv_set_update(r->opv, g, veil_ev_texture(r->ev), o->no_skip ? 0 : veil_ev_occupancy(r->ev),
@@ -239,7 +248,9 @@ static veil_result propagate(veil_renderer* r, const veil_scene* s, const veil_l
     st->opv_computed = orep.computed;
     st->opv_cached = orep.cached;
     st->propagate_iterations = orep.iterations;
-    rep->key = veil_hash_bytes(r->ev_key, &params, sizeof params);
+    veil_opv_params keyed = params;
+    keyed.sun_bytes = 0.0; /* as the textures' keys: the allowance shows through the grids it makes */
+    rep->key = veil_hash_bytes(r->ev_key, &keyed, sizeof keyed);
     for (int l = 0; l < n; ++l) {
         veil_opv_light ol;
         veil_opv_light_from_world(g, &lights[l], &ol);

@@ -111,9 +111,11 @@ veil_result veil_render_density(veil_renderer* r, const veil_scene* s, const vei
 int veil_render_lights(const veil_scene* s, const veil_grid* g, veil_light* out);
 
 /* The propagation parameters for s under resolved options o: the method,
- * the light-space spacing, and the Jacobi tolerance on D that keeps
- * sigma_t D within VEIL_OPV_TAU_TOLERANCE. */
-veil_opv_params veil_render_opv_params(const veil_scene* s, const veil_render_opts* o);
+ * the light-space spacing, the Jacobi tolerance on D that keeps sigma_t D
+ * within VEIL_OPV_TAU_TOLERANCE, and (grid g, a device budget of `budget`
+ * bytes; NULL or 0: none) the memory left for the suns' grids. */
+veil_opv_params veil_render_opv_params(const veil_scene* s, const veil_render_opts* o, const veil_grid* g,
+                                       unsigned long long budget);
 
 /* What a rung of the quality ladder sets (each 0 left to the options). */
 typedef struct veil_quality_rung {

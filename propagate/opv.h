@@ -92,6 +92,8 @@ typedef struct veil_opv_params {
     float sun_across;   /* light-space: node spacing across the light (voxels); 0 = VEIL_SUN_DEFAULT_ACROSS */
     float sun_along;    /* ... along the light (voxels); 0 = VEIL_SUN_DEFAULT_ALONG */
     int sun_panels;     /* ... Simpson panels per step along it; 0 = VEIL_SUN_DEFAULT_PANELS */
+    double sun_bytes;   /* ... the most GPU memory all of a scene's grids may take (bytes); 0: no limit
+                           beyond VEIL_SUN_MAX_NODES (frame/ gives what the device's budget leaves) */
 } veil_opv_params;
 
 /* Chosen from the measurements in docs/performance.md. */

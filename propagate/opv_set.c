@@ -71,9 +71,18 @@ const veil_opv_sun* veil_opv_set_suns(const veil_opv_set* s, int* count)
     return s->sun;
 }
 
+/* The parameters a key holds: all but the suns' memory allowance, which
+ * shows in a grid's key through the grid it makes (its spacing). */
+static uint64_t params_key(uint64_t key, const veil_opv_params* params)
+{
+    veil_opv_params p = *params;
+    p.sun_bytes = 0.0;
+    return veil_hash_bytes(key, &p, sizeof p);
+}
+
 uint64_t veil_opv_texture_key(uint64_t ev_key, const veil_opv_params* params, const veil_opv_light* lights, int count)
 {
-    uint64_t key = veil_hash_bytes(ev_key, params, sizeof *params);
+    uint64_t key = params_key(ev_key, params);
     for (int c = 0; c < count; ++c) key = veil_hash_bytes(key, &lights[c], sizeof lights[c]);
     return key;
 }
@@ -249,6 +258,8 @@ int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* li
     int count = 0;
     for (int l = 0; l < n; ++l) veil_opv_light_from_world(g, &lights[l], &ol[l]);
     if (veil_opv_method_resolve(params->method) != VEIL_OPV_LIGHT_SPACE) return 0;
+    int suns = 0; /* the memory allowed is shared by the suns that may get a grid */
+    for (int l = 0; l < n && suns < VEIL_MAX_SUNS; ++l) suns += lights[l].type == VEIL_LIGHT_DIRECTIONAL;
     for (int l = 0; l < n && count < VEIL_MAX_SUNS; ++l) {
         if (lights[l].type != VEIL_LIGHT_DIRECTIONAL) continue;
         veil_opv_sun* w = &want[count];
@@ -256,6 +267,8 @@ int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* li
         veil_error ignored;
         size_t voxels = veil_grid_voxels(g), most = VEIL_SUN_MAX_NODES;
         if (voxels < most / VEIL_SUN_NODES_PER_VOXEL) most = voxels * VEIL_SUN_NODES_PER_VOXEL;
+        if (params->sun_bytes > 0.0 && params->sun_bytes / (4.0 * suns) < (double)most)
+            most = (size_t)(params->sun_bytes / (4.0 * suns)); /* r32f nodes */
         /* the spacing asked for, widened across the light by 5/4 at a time until the grid fits */
         float across = veil_opv_sun_across(params);
         veil_result made = VEIL_ERR_LIMIT;
@@ -265,7 +278,7 @@ int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* li
         if (made != VEIL_OK) continue; /* too large a grid even so: this sun stays on the EV's grid */
         w->light = l;
         veil_sun_space_to_texture(g, &w->space, w->to_tex);
-        want_key[count] = veil_hash_bytes(veil_hash_bytes(ev_key, params, sizeof *params), &w->space, sizeof w->space);
+        want_key[count] = veil_hash_bytes(params_key(ev_key, params), &w->space, sizeof w->space);
         ol[l].elsewhere = 1;
         ++count;
     }

@@ -22,6 +22,10 @@
  *    moves, so single halvings scatter around 4 (3.0 to 6.5 measured here).
  *    Asked: at least 2.5x from 1 to 2 panels and 8x from 1 to 4 (16
  *    expected); first order would give 2x and 4x.
+ * 4. The plan (veil_opv_plan_suns): only the light-space method makes
+ *    grids, for the first VEIL_MAX_SUNS suns; a grid over its node budget
+ *    or the memory allowed is widened across the light until it fits, and
+ *    a sun whose grid cannot fit stays on the EV's grid.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -29,6 +33,7 @@
 
 #include "check.h"
 #include "puffs.h"
+#include "propagate/opv_set.h"
 #include "propagate/sun_space.h"
 #include "reference/optical_depth.h"
 
@@ -174,8 +179,51 @@ static void test_second_order(void)
     free(rho);
 }
 
+static void test_plan(void)
+{
+    veil_grid g = {.dims = {64, 64, 64}, .origin = {0, 0, 0}, .voxel = 0.1f};
+    veil_light lights[7] = {{0}};
+    for (int l = 0; l < 7; ++l) {
+        lights[l].type = l == 2 ? VEIL_LIGHT_POINT : VEIL_LIGHT_DIRECTIONAL;
+        lights[l].direction[0] = 0.2f * l - 0.5f, lights[l].direction[1] = -1.0f, lights[l].direction[2] = 0.3f;
+        lights[l].color[0] = lights[l].color[1] = lights[l].color[2] = 1.0f;
+    }
+    veil_opv_light ol[7];
+    veil_opv_sun want[VEIL_MAX_SUNS];
+    uint64_t keys[VEIL_MAX_SUNS];
+    veil_opv_params p = {.method = VEIL_OPV_SEMI_LAGRANGIAN};
+    CHECK(veil_opv_plan_suns(&g, 1, lights, 7, &p, 2048, ol, want, keys) == 0 && !ol[0].elsewhere,
+          "semi-lagrangian: no grids");
+    p.method = VEIL_OPV_LIGHT_SPACE;
+    int n = veil_opv_plan_suns(&g, 1, lights, 7, &p, 2048, ol, want, keys);
+    CHECK(n == VEIL_MAX_SUNS, "%d grids for 6 suns (the first %d get one)", n, VEIL_MAX_SUNS);
+    const int expect[7] = {1, 1, 0, 1, 1, 0, 0}; /* light 2 is a point light; lights 5 and 6 come after four suns */
+    for (int l = 0; l < 7; ++l) CHECK(ol[l].elsewhere == expect[l], "light %d: elsewhere %d", l, ol[l].elsewhere);
+    for (int k = 0; k < n; ++k) {
+        CHECK(want[k].light == (k < 2 ? k : k + 1), "grid %d serves light %d", k, want[k].light);
+        CHECK(fabs(len3(want[k].space.axis[0]) - VEIL_SUN_DEFAULT_ACROSS) < 1e-6, "grid %d: spacing %g", k,
+              len3(want[k].space.axis[0]));
+    }
+    /* two nodes a voxel for each of the four suns that may get a grid: the spacing widens to fit */
+    p.sun_bytes = 4.0 * VEIL_MAX_SUNS * 2 * (double)veil_grid_voxels(&g);
+    n = veil_opv_plan_suns(&g, 1, lights, 7, &p, 2048, ol, want, keys);
+    CHECK(n == VEIL_MAX_SUNS, "%d grids under the memory allowance", n);
+    int widened = 0;
+    for (int k = 0; k < n; ++k) {
+        size_t nodes = veil_sun_space_nodes(&want[k].space);
+        CHECK(nodes <= 2 * veil_grid_voxels(&g), "grid %d: %zu nodes (at most %zu), spacing %g", k, nodes,
+              2 * veil_grid_voxels(&g), len3(want[k].space.axis[0]));
+        widened += len3(want[k].space.axis[0]) > VEIL_SUN_DEFAULT_ACROSS + 1e-6;
+    }
+    CHECK(widened >= 1, "no grid was widened (the first needs 742 482 nodes at the default spacing)");
+    p.sun_bytes = 1.0; /* nothing fits: every sun stays on the EV's grid */
+    n = veil_opv_plan_suns(&g, 1, lights, 7, &p, 2048, ol, want, keys);
+    CHECK(n == 0 && !ol[0].elsewhere && !ol[1].elsewhere, "no memory: %d grids", n);
+}
+
 int main(void)
 {
+    test_plan();
     test_geometry();
     test_linear_exact();
     test_second_order();
