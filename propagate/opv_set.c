@@ -269,10 +269,11 @@ int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* li
         if (voxels < most / VEIL_SUN_NODES_PER_VOXEL) most = voxels * VEIL_SUN_NODES_PER_VOXEL;
         if (params->sun_bytes > 0.0 && params->sun_bytes / (4.0 * suns) < (double)most)
             most = (size_t)(params->sun_bytes / (4.0 * suns)); /* r32f nodes */
-        /* the spacing asked for, widened across the light by 5/4 at a time until the grid fits */
-        float across = veil_opv_sun_across(params);
+        /* the spacing asked for, widened across the light by 5/4 at a time until the grid fits
+         * (up to VEIL_SUN_WIDEST voxels, or what was asked if wider) */
+        float across = veil_opv_sun_across(params), widest = across > VEIL_SUN_WIDEST ? across : VEIL_SUN_WIDEST;
         veil_result made = VEIL_ERR_LIMIT;
-        for (; made != VEIL_OK && across <= VEIL_SUN_WIDEST; across *= 1.25f)
+        for (; made != VEIL_OK && across <= widest; across *= 1.25f)
             made = veil_sun_space_make(g, lights[l].direction, across, veil_opv_sun_along(params),
                                        veil_opv_sun_panels(params), max_axis, most, &w->space, &ignored);
         if (made != VEIL_OK) continue; /* too large a grid even so: this sun stays on the EV's grid */
