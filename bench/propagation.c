@@ -229,7 +229,7 @@ static int cmp_double(const void* a, const void* b)
 
 /* Runs veil_opv_gpu `runs` times (once when the first run exceeds
  * REPEAT_LIMIT_MS); *median_ms, *passes, *runs_done. */
-static veil_result time_opv(const bench* b, const veil_grid* g, GLuint ev, const veil_opv_light* lights, int n_lights,
+static veil_result time_opv(bench* b, const veil_grid* g, GLuint ev, const veil_opv_light* lights, int n_lights,
                             const veil_opv_params* params, const GLuint* opv, int runs, double* median_ms,
                             int* passes, int* runs_done, veil_error* err)
 {

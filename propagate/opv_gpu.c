@@ -6,7 +6,7 @@
 
 veil_result veil_opv_programs_create(veil_opv_programs* p, veil_error* err)
 {
-    p->jacobi = p->sweep = 0;
+    p->jacobi = p->sweep = p->sweep_one = 0;
     veil_result r = veil_gpu_program("propagate/shaders/propagate_jacobi.comp", &p->jacobi, err);
     if (r == VEIL_OK) r = veil_gpu_program("propagate/shaders/propagate_sweep.comp", &p->sweep, err);
     if (r != VEIL_OK) veil_opv_programs_destroy(p);
@@ -17,7 +17,8 @@ void veil_opv_programs_destroy(veil_opv_programs* p)
 {
     glDeleteProgram(p->jacobi);
     glDeleteProgram(p->sweep);
-    p->jacobi = p->sweep = 0;
+    glDeleteProgram(p->sweep_one);
+    p->jacobi = p->sweep = p->sweep_one = 0;
 }
 
 static GLint loc(GLuint prog, const char* name) { return glGetUniformLocation(prog, name); }
@@ -169,7 +170,7 @@ static int sweep_light(GLuint prog, const veil_grid* g, const veil_opv_light* L,
     return passes;
 }
 
-veil_result veil_opv_gpu(const veil_opv_programs* p, const veil_grid* g, GLuint ev, const veil_opv_light* lights,
+veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, const veil_opv_light* lights,
                          int n_lights, const veil_opv_params* params, const GLuint* opv, int* iterations,
                          veil_error* err)
 {
@@ -186,16 +187,23 @@ veil_result veil_opv_gpu(const veil_opv_programs* p, const veil_grid* g, GLuint 
         glProgramUniform1f(prog, loc(prog, "u_voxel"), g->voxel);
         r = run_jacobi(prog, g, lights, n_lights, params, opv, &most, err);
     } else if (params->method == VEIL_OPV_SWEEP || params->method == VEIL_OPV_SEMI_LAGRANGIAN) {
-        GLuint prog = p->sweep;
         static const GLfloat zero[4] = {0, 0, 0, 0};
-        glUseProgram(prog);
-        glProgramUniform3i(prog, loc(prog, "u_dims"), g->dims[0], g->dims[1], g->dims[2]);
-        glProgramUniform1f(prog, loc(prog, "u_voxel"), g->voxel);
-        glProgramUniform1f(prog, loc(prog, "u_exit_steps"), veil_opv_exit_steps(params));
-        glProgramUniform1i(prog, loc(prog, "u_characteristic"), veil_opv_characteristic(params));
-        for (int t = 0; 4 * t < n_lights; ++t) {
-            glClearTexImage(opv[t], 0, GL_RGBA, GL_FLOAT, zero);
-            glBindImageTexture(VEIL_IMAGE_OPV_DST, opv[t], 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+        for (int t = 0; 4 * t < n_lights && r == VEIL_OK; ++t) {
+            GLint format = 0;
+            glGetTextureLevelParameteriv(opv[t], 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
+            int one = format == GL_R32F; /* one light: channel 0 of an r32f texture */
+            if (one && !p->sweep_one)
+                r = veil_gpu_program_variant("propagate/shaders/propagate_sweep.comp", "#define VEIL_OPV_ONE_CHANNEL 1\n",
+                                             "one light", &p->sweep_one, err);
+            if (r != VEIL_OK) break;
+            GLuint prog = one ? p->sweep_one : p->sweep;
+            glUseProgram(prog);
+            glProgramUniform3i(prog, loc(prog, "u_dims"), g->dims[0], g->dims[1], g->dims[2]);
+            glProgramUniform1f(prog, loc(prog, "u_voxel"), g->voxel);
+            glProgramUniform1f(prog, loc(prog, "u_exit_steps"), veil_opv_exit_steps(params));
+            glProgramUniform1i(prog, loc(prog, "u_characteristic"), veil_opv_characteristic(params));
+            glClearTexImage(opv[t], 0, one ? GL_RED : GL_RGBA, GL_FLOAT, zero);
+            glBindImageTexture(VEIL_IMAGE_OPV_DST, opv[t], 0, GL_TRUE, 0, GL_READ_WRITE, one ? GL_R32F : GL_RGBA32F);
             for (int c = 0; c < 4 && 4 * t + c < n_lights; ++c) {
                 if (lights[4 * t + c].elsewhere) continue; /* its channel stays 0 */
                 glProgramUniform1i(prog, loc(prog, "u_channel"), c);

@@ -12,15 +12,17 @@
 
 typedef struct veil_opv_programs {
     GLuint jacobi, sweep;
+    GLuint sweep_one; /* the sweep on an r32f texture of one light, made when first needed */
 } veil_opv_programs;
 
 veil_result veil_opv_programs_create(veil_opv_programs* p, veil_error* err);
 void veil_opv_programs_destroy(veil_opv_programs* p);
 
 /* Fills opv[t] (ceil(n_lights/4) rgba32f textures of the grid's size, made
- * by the caller) for lights 4t..4t+3; ev is the r32f density texture.
+ * by the caller; for the ordered methods a texture of one light may be
+ * r32f) for lights 4t..4t+3; ev is the r32f density texture.
  * *iterations: the most Jacobi steps, or sweep passes, any light needed. */
-veil_result veil_opv_gpu(const veil_opv_programs* p, const veil_grid* g, GLuint ev, const veil_opv_light* lights,
+veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, const veil_opv_light* lights,
                          int n_lights, const veil_opv_params* params, const GLuint* opv, int* iterations,
                          veil_error* err);
 

@@ -16,6 +16,7 @@ struct veil_opv_set {
     GLuint sun_program;    /* propagate/shaders/sun_prefix.comp, made when first needed */
     GLuint tex[VEIL_MAX_OPV_TEXTURES];
     int dims[VEIL_MAX_OPV_TEXTURES][3];
+    GLenum format[VEIL_MAX_OPV_TEXTURES]; /* rgba32f, or r32f for one light on the grid (ordered methods) */
     uint64_t key[VEIL_MAX_OPV_TEXTURES]; /* 0: none (or being remade) */
     veil_opv_sun sun[VEIL_MAX_SUNS];     /* the first `suns` in use */
     uint64_t sun_key[VEIL_MAX_SUNS];     /* 0: none (or being remade) */
@@ -89,15 +90,17 @@ uint64_t veil_opv_texture_key(uint64_t ev_key, const veil_opv_params* params, co
 
 int veil_opv_set_has(const veil_opv_set* s, int t, uint64_t key) { return s->tex[t] && s->key[t] == key; }
 
-/* Texture t of dims (kept when it has them already). */
-static veil_result texture_of(veil_opv_set* s, int t, const int dims[3], const char* label, veil_error* err)
+/* Texture t of dims and format (kept when it has them already). */
+static veil_result texture_of(veil_opv_set* s, int t, const int dims[3], GLenum format, const char* label,
+                              veil_error* err)
 {
-    if (s->tex[t] && !memcmp(s->dims[t], dims, sizeof s->dims[t])) return VEIL_OK;
+    if (s->tex[t] && !memcmp(s->dims[t], dims, sizeof s->dims[t]) && s->format[t] == format) return VEIL_OK;
     glDeleteTextures(1, &s->tex[t]);
     s->tex[t] = 0;
     memset(s->dims[t], 0, sizeof s->dims[t]);
-    veil_result r = veil_gl_texture3d(GL_RGBA32F, dims, label, &s->tex[t], err);
+    veil_result r = veil_gl_texture3d(format, dims, label, &s->tex[t], err);
     if (r == VEIL_OK) memcpy(s->dims[t], dims, sizeof s->dims[t]);
+    s->format[t] = format;
     return r;
 }
 
@@ -369,13 +372,17 @@ veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, 
             continue;
         }
         const int* td = sp ? sp->atlas_texels : g->dims;
-        rep->mib += (double)td[0] * td[1] * td[2] * 16.0 / 1048576.0;
+        /* one light on the grid by an ordered method: r32f (the march reads channel 0 either way) */
+        veil_opv_method m = veil_opv_method_resolve(params->method);
+        int one = !sp && on_grid == 1 && count == 1 && m != VEIL_OPV_JACOBI && m != VEIL_OPV_JACOBI_CORRECTED;
+        rep->mib += (double)td[0] * td[1] * td[2] * (one ? 4.0 : 16.0) / 1048576.0;
         uint64_t key = veil_opv_texture_key(ev_key, params, ol + 4 * t, count);
         if (veil_opv_set_has(s, t, key)) {
             ++rep->cached;
             continue;
         }
-        r = texture_of(s, t, sp ? sp->atlas_texels : g->dims, sp ? "veil optical depth (sparse atlas)" : "veil optical-depth volume", err);
+        r = texture_of(s, t, td, one ? GL_R32F : GL_RGBA32F,
+                       sp ? "veil optical depth (sparse atlas)" : "veil optical-depth volume", err);
         int it = 0;
         s->key[t] = 0;
         if (r == VEIL_OK && sp) r = sparse_depths(s, sp, ol + 4 * t, count, s->tex[t], &it, err);
@@ -408,13 +415,19 @@ veil_result veil_opv_set_propagate_readback(veil_opv_set* s, const veil_grid* g,
         glTextureSubImage3D(ev, 0, 0, 0, 0, g->dims[0], g->dims[1], g->dims[2], GL_RED, GL_FLOAT, density);
         r = veil_gl_check("uploading the extinction volume", err);
     }
-    for (int t = 0; t < n_tex && r == VEIL_OK; ++t)
-        r = veil_gl_texture3d(GL_RGBA32F, g->dims, "veil optical-depth volume", &opv[t], err);
+    /* as veil_opv_set_update makes them: a texture of one light is r32f for the ordered methods */
+    veil_opv_method m = veil_opv_method_resolve(params->method);
+    int ordered = m != VEIL_OPV_JACOBI && m != VEIL_OPV_JACOBI_CORRECTED;
+    for (int t = 0; t < n_tex && r == VEIL_OK; ++t) {
+        int one = ordered && n_lights - 4 * t == 1;
+        r = veil_gl_texture3d(one ? GL_R32F : GL_RGBA32F, g->dims, "veil optical-depth volume", &opv[t], err);
+    }
     if (r == VEIL_OK) r = veil_opv_gpu(&s->programs, g, ev, lights, n_lights, params, opv, iterations, err);
     for (int t = 0; t < n_tex && r == VEIL_OK; ++t) {
-        r = veil_gl_read_texture(opv[t], GL_RGBA, nv * 4, tmp, "reading back an OPV", err);
+        int one = ordered && n_lights - 4 * t == 1;
+        r = veil_gl_read_texture(opv[t], one ? GL_RED : GL_RGBA, nv * (one ? 1 : 4), tmp, "reading back an OPV", err);
         for (int c = 0; c < 4 && 4 * t + c < n_lights && r == VEIL_OK; ++c)
-            for (size_t v = 0; v < nv; ++v) out[(size_t)(4 * t + c) * nv + v] = tmp[4 * v + c];
+            for (size_t v = 0; v < nv; ++v) out[(size_t)(4 * t + c) * nv + v] = tmp[(one ? 1 : 4) * v + c];
     }
     glDeleteTextures(1, &ev);
     glDeleteTextures(VEIL_MAX_OPV_TEXTURES, opv);

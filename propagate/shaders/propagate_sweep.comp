@@ -11,7 +11,11 @@
 layout(local_size_x = VEIL_SWEEP_GROUP) in;
 
 layout(binding = VEIL_IMAGE_EV, r32f) readonly uniform image3D u_ev;
+#ifdef VEIL_OPV_ONE_CHANNEL // a texture of one light: r32f, channel 0
+layout(binding = VEIL_IMAGE_OPV_DST, r32f) uniform image3D u_opv;
+#else
 layout(binding = VEIL_IMAGE_OPV_DST, rgba32f) uniform image3D u_opv;
+#endif
 
 uniform ivec3 u_dims;
 uniform float u_voxel;
@@ -31,14 +35,22 @@ uniform ivec3 u_box_n[12];
 #define VEIL_CTX_ARG
 #define VEIL_DIMS(a) u_dims[a]
 #define VEIL_RHO(i, j, k) imageLoad(u_ev, ivec3(i, j, k)).r
+#ifdef VEIL_OPV_ONE_CHANNEL
+#define VEIL_DIN(i, j, k) imageLoad(u_opv, ivec3(i, j, k)).r
+#else
 #define VEIL_DIN(i, j, k) imageLoad(u_opv, ivec3(i, j, k))[u_channel]
+#endif
 //@include propagate/opv_schemes.glsl.h
 
 void store(ivec3 x, float D)
 {
+#ifdef VEIL_OPV_ONE_CHANNEL
+    imageStore(u_opv, x, vec4(D));
+#else
     vec4 v = imageLoad(u_opv, x);
     v[u_channel] = D;
     imageStore(u_opv, x, v);
+#endif
 }
 
 int gather_dist(int a, int x)
