@@ -57,7 +57,7 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
 #else
     vec2 s = box_hit(x, to, u.box_min.xyz, u.box_max.xyz, 0.0, len);
     if (s.x > s.y) return 0.0;
-    vec3 y = x + to * s.x;
+    vec3 y = x + to * s.x; // where the path enters the box; s.y - s.x of it lies inside
     int k = u.sun_of[l / 4][l % 4] - 1;
     if (k >= 0) { // a sun in its light-space grid (propagate/sun_space.h)
         // D at the node plane just towards the light (exact along the light:
@@ -74,7 +74,7 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
         float D = texture(u_sun[k], q).r;
         // the stretch's part in the box (the medium ends at its faces: a piece across one would
         // count density beyond it)
-        back = min(back, box_hit(y, to, u.box_min.xyz, u.box_max.xyz, 0.0, INF).y);
+        back = min(back, s.y - s.x);
         int n = int(u.sun_step[k].z);
         float piece = back / float(n);
         for (int i = 0; i < n && back > 0.0; ++i) D += ev_density(y + to * (piece * (float(i) + 0.5))) * piece;
