@@ -191,8 +191,9 @@ static veil_result inject_scene(veil_renderer* r, const veil_scene* s, veil_rend
 
 /* ---- stage 2: propagate ------------------------------------------------ */
 
-/* The ladder, chosen from bench/peers (docs/performance.md): each rung
- * neither slower nor less accurate than the one below it on every scene measured. */
+/* The ladder, chosen from bench/peers.py --knobs (docs/performance.md):
+ * each rung slower and more accurate than the one below it on the shared
+ * smoke, none dominated on the three scenes of bench/peers.py. */
 static const veil_quality_rung rungs[VEIL_QUALITY_COUNT] = {
     [VEIL_QUALITY_DRAFT] = {1.0f, VEIL_OPV_LIGHT_SPACE, 1.0f, 4.0f},
     [VEIL_QUALITY_DEFAULT] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.5f, 4.0f},

@@ -60,11 +60,11 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
     vec3 y = x + to * s.x; // where the path enters the box; s.y - s.x of it lies inside
     int k = u.sun_of[l / 4][l % 4] - 1;
     if (k >= 0) { // a sun in its light-space grid (propagate/sun_space.h)
-        // D at the node plane just towards the light (exact along the light:
-        // no interpolation between planes there) plus the density over the
-        // last stretch, midpoint rule in sun_step.z pieces of at most a voxel: linear
-        // interpolation between planes over-darkened the lit faces, where D
-        // rises from 0 within a node spacing
+        // D on the node plane just towards the light (bilinear within the
+        // plane, none between planes) plus the density over the stretch
+        // back to y, midpoint rule in sun_step.z pieces of at most a voxel:
+        // interpolating between planes over-darkened the lit faces, where D
+        // rises from 0 within one node spacing (docs/performance.md)
         vec4 p = vec4(y, 1.0);
         vec3 q = vec3(dot(u.sun_map[3 * k], p), dot(u.sun_map[3 * k + 1], p), dot(u.sun_map[3 * k + 2], p));
         float c = q.z * u.sun_step[k].y - 0.5;
