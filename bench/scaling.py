@@ -16,9 +16,10 @@ scattering, 320x240, quality default. Sweeps:
   the optical depths once, the march every frame).
 Times: each stage's wall time from `veil render --stats` (summed over the
 frames of a turntable) and the whole process, medians of --runs. Results:
-OUT/scaling.md. Python 3 standard library only.
+OUT/scaling.md. Needs OpenVDB's vdb_tool (Debian libopenvdb-tools, as
+`make peers` installs it). Python 3 standard library only.
 """
-import argparse, json, math, os, statistics, subprocess, sys, time
+import argparse, json, math, os, shutil, statistics, subprocess, sys, time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BUILD = os.path.join(ROOT, "build")
@@ -108,6 +109,8 @@ def main():
     os.makedirs(CACHE, exist_ok=True)
     sphere = os.path.join(BUILD, "bench-cache", "peers", "fog_sphere.vdb")
     if not os.path.exists(sphere):
+        if not shutil.which("vdb_tool"):
+            sys.exit("scaling: vdb_tool not found: install it with  bash scripts/install-bench-deps.sh libopenvdb-tools")
         os.makedirs(os.path.dirname(sphere), exist_ok=True)
         run(["vdb_tool", "-sphere", "dim=128", "radius=1.0", "center=0,0,0", "width=3", "-ls2fog", "name=density",
              "-write", sphere])
