@@ -11,5 +11,6 @@ int veil_cmd_info(int argc, char** argv);
 int veil_cmd_rbf(int argc, char** argv);
 int veil_cmd_render(int argc, char** argv);
 int veil_cmd_reference(int argc, char** argv);
+int veil_cmd_turntable(int argc, char** argv);
 
 #endif

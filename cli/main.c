@@ -25,6 +25,10 @@ static const char* usage_text =
     "usage: veil render SCENE.json -o OUT.exr [--png OUT.png] [--width W] [--height H]\n"
     "                   [--quality Q] [--step S] [--od-spacing A[,B]] [--seed N] [--method M]\n"
     "                   [--turntable N] [--aovs] [--stats] [--explain]\n"
+    "       veil turntable SCENE.json -o OUT.####.exr [--frames N | --range A-B[xS]] [--png OUT.####.png]\n"
+    "                [--axis X,Y,Z] [--start DEG] [--degrees DEG] [--elevation DEG] [--shard I/N]\n"
+    "                [--skip-existing] [--quality Q] [--step S] [--seed N] [--width W] [--height H]\n"
+    "                [--method M] [--aovs] [--stats] [--explain]\n"
     "       veil reference SCENE.json -o REF.exr --spp N [--max-order K] [--width W]\n"
     "                [--height H] [--seed N] [--threads T] [--light-sampling distance|mis]\n"
     "       veil compare A.exr REF.exr [--heatmap OUT.png] [--floor F] [--bin B] [--json]\n"
@@ -65,6 +69,15 @@ static const char* usage_text =
     "                 cached or skipped, and why\n"
     "  --explain      print which stages run on which frame and why, without rendering\n"
     "                 (no GPU needed; -o may be left out)\n"
+    "turntable  renders frames of a scene, the camera orbiting its look-at point: frame f of\n"
+    "         a range of n at --start + --degrees * i / n (i its index; default a full turn\n"
+    "         about the camera's up axis, or --axis), raised by --elevation first. OUT holds\n"
+    "         the frame number once, as #### (digits at least) or %04d. The volume and\n"
+    "         optical depth are computed once; each frame's image depends only on the scene\n"
+    "         and its number (jitter seeded per frame), so shards make the same bytes.\n"
+    "  --frames N     frames 1..N (default 1); --range A-B[xS]: A, A+S, ... up to B\n"
+    "  --shard I/N    only every N-th frame of the range, starting with its I-th (a farm task)\n"
+    "  --skip-existing  leave frames whose files exist (frames are renamed into place whole)\n"
     "reference  renders a scene with the CPU path tracer (reference/pathtracer.h), the\n"
     "         ground truth the GPU path is measured against. The EXR holds R, G, B, A and\n"
     "         the per-pixel standard error of each mean (stderr.R, stderr.G, stderr.B).\n"
@@ -126,6 +139,7 @@ int main(int argc, char** argv)
         return EXIT_OK;
     }
     if (!strcmp(cmd, "render")) return veil_cmd_render(argc, argv);
+    if (!strcmp(cmd, "turntable")) return veil_cmd_turntable(argc, argv);
     if (!strcmp(cmd, "info")) return veil_cmd_info(argc, argv);
     if (!strcmp(cmd, "rbf")) return veil_cmd_rbf(argc, argv);
     if (!strcmp(cmd, "reference")) return veil_cmd_reference(argc, argv);

@@ -2,6 +2,7 @@ veil_test(test_rbf SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_rbf.c LABELS unit)
 veil_test(test_propagate_homogeneous SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_propagate_homogeneous.c LABELS unit)
 veil_test(test_propagate_accuracy SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_propagate_accuracy.c LABELS "unit;accuracy")
 veil_test(test_sun_space SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_sun_space.c LABELS "unit;accuracy")
+veil_test(test_frames SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_frames.c LABELS unit)
 # The layout's include rules (docs/architecture.md) hold on the tree, and
 # the checker catches each kind of violation on trees made for the purpose.
 add_test(NAME check_layout COMMAND bash ${PROJECT_SOURCE_DIR}/scripts/check-layout.sh ${PROJECT_SOURCE_DIR})

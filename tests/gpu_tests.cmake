@@ -54,3 +54,7 @@ set_tests_properties(fog_cli PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)
 # The volumetric fields (render/diffusion.h): the octaves' escape field
 # against its closed form, the diffusion fluence's convergence.
 veil_test(test_diffusion SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_diffusion.c LABELS "gpu;accuracy")
+# veil turntable: ranges, shards (byte-identical to one run), --skip-existing, usage errors.
+add_test(NAME cli_turntable
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/turntable_cli.sh $<TARGET_FILE:veil_cli> ${PROJECT_SOURCE_DIR}/data/scenes/rbf_fog.json)
+set_tests_properties(cli_turntable PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)

@@ -1,0 +1,229 @@
+/* veil turntable: many frames of one scene, the camera on an orbit, frame
+ * numbers and ranges as film tools use them, shards for a render farm. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "cli_util.h"
+#include "commands.h"
+#include "progress.h"
+#include "core/clock.h"
+#include "frame/frames.h"
+#include "frame/plan.h"
+#include "frame/renderer.h"
+#include "gpu/gl_context.h"
+#include "io/image.h"
+#include "io/scene.h"
+
+typedef struct tt_args {
+    const char *scene, *exr, *png;
+    long width, height, seed, frames;
+    veil_frame_range range;
+    int have_range, shard, shards, skip_existing, stats, explain, aovs;
+    float step, sun_across, sun_along;
+    veil_opv_method method;
+    veil_quality quality;
+    veil_orbit orbit;
+} tt_args;
+
+static int parse_vec3(const char* v, float out[3])
+{
+    char extra;
+    return sscanf(v, "%f,%f,%f%c", &out[0], &out[1], &out[2], &extra) == 3 && isfinite(out[0]) && isfinite(out[1]) &&
+           isfinite(out[2]);
+}
+
+static int parse_args(int argc, char** argv, tt_args* a)
+{
+    memset(a, 0, sizeof *a);
+    a->orbit.degrees = 360.0f;
+    a->shard = a->shards = 1;
+    for (int i = 2; i < argc; ++i) {
+        const char* s = argv[i];
+        const char* v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(s, "--stats")) { a->stats = 1; continue; }
+        if (!strcmp(s, "--explain")) { a->explain = 1; continue; }
+        if (!strcmp(s, "--aovs")) { a->aovs = 1; continue; }
+        if (!strcmp(s, "--skip-existing")) { a->skip_existing = 1; continue; }
+        if (s[0] != '-' || !s[1]) {
+            if (a->scene) return veil_cli_usage_error("unexpected argument '%s'", s);
+            a->scene = s;
+            continue;
+        }
+        if (!v) return veil_cli_usage_error("%s needs a value (or is unknown)", s);
+        veil_error err = {0};
+        if (!strcmp(s, "-o")) a->exr = v;
+        else if (!strcmp(s, "--png")) a->png = v;
+        else if (!strcmp(s, "--frames")) {
+            if (!veil_cli_parse_int(v, 1, VEIL_MAX_FRAMES, &a->frames))
+                return veil_cli_usage_error("--frames: expected a number of frames in 1..10000000, got '%s'", v);
+        } else if (!strcmp(s, "--range")) {
+            if (veil_frame_range_parse(v, &a->range, &err) != VEIL_OK) return veil_cli_usage_error("--range: %s", err.msg);
+            a->have_range = 1;
+        } else if (!strcmp(s, "--shard")) {
+            if (veil_shard_parse(v, &a->shard, &a->shards, &err) != VEIL_OK) return veil_cli_usage_error("--shard: %s", err.msg);
+        } else if (!strcmp(s, "--axis")) {
+            if (!parse_vec3(v, a->orbit.axis) ||
+                !(fabsf(a->orbit.axis[0]) + fabsf(a->orbit.axis[1]) + fabsf(a->orbit.axis[2]) > 0.0f))
+                return veil_cli_usage_error("--axis: expected a non-zero X,Y,Z, got '%s'", v);
+        } else if (!strcmp(s, "--start")) {
+            if (!veil_cli_parse_float(v, -36000.0f, 36000.0f, &a->orbit.start_deg))
+                return veil_cli_usage_error("--start: expected degrees in -36000..36000, got '%s'", v);
+        } else if (!strcmp(s, "--degrees")) {
+            if (!veil_cli_parse_float(v, -36000.0f, 36000.0f, &a->orbit.degrees))
+                return veil_cli_usage_error("--degrees: expected degrees in -36000..36000, got '%s'", v);
+        } else if (!strcmp(s, "--elevation")) {
+            if (!veil_cli_parse_float(v, -89.0f, 89.0f, &a->orbit.elevation_deg))
+                return veil_cli_usage_error("--elevation: expected degrees in -89..89, got '%s'", v);
+        } else if (!strcmp(s, "--width")) {
+            if (!veil_cli_parse_int(v, 1, VEIL_SCENE_MAX_IMAGE, &a->width)) return veil_cli_usage_error("--width: expected an integer in 1..16384, got '%s'", v);
+        } else if (!strcmp(s, "--height")) {
+            if (!veil_cli_parse_int(v, 1, VEIL_SCENE_MAX_IMAGE, &a->height)) return veil_cli_usage_error("--height: expected an integer in 1..16384, got '%s'", v);
+        } else if (!strcmp(s, "--step")) {
+            if (!veil_cli_parse_float(v, 0.01f, 16.0f, &a->step)) return veil_cli_usage_error("--step: expected a number of voxels in 0.01..16, got '%s'", v);
+        } else if (!strcmp(s, "--seed")) {
+            if (!veil_cli_parse_int(v, 0, 4294967295L, &a->seed)) return veil_cli_usage_error("--seed: expected an integer in 0..4294967295, got '%s'", v);
+        } else if (!strcmp(s, "--method")) {
+            if (!veil_opv_method_parse(v, &a->method))
+                return veil_cli_usage_error("--method: expected default, jacobi, jacobi-corrected, sweep, semi-lagrangian or light-space, got '%s'", v);
+        } else if (!strcmp(s, "--quality")) {
+            if (!veil_quality_parse(v, &a->quality))
+                return veil_cli_usage_error("--quality: expected draft, default, high or max, got '%s'", v);
+        } else {
+            return veil_cli_usage_error("unknown option '%s'", s);
+        }
+        ++i;
+    }
+    if (!a->scene) return veil_cli_usage_error("%s", "turntable: missing SCENE.json");
+    if (!a->exr && !a->explain) return veil_cli_usage_error("%s", "turntable: missing -o OUT.####.exr");
+    if (a->frames && a->have_range) return veil_cli_usage_error("%s", "turntable: --frames and --range: give one");
+    if (!a->have_range) a->range = (veil_frame_range){1, a->frames ? a->frames : 1, 1};
+    if (a->exr && veil_frame_pattern_kind(a->exr) != 1)
+        return veil_cli_usage_error("-o: '%s' needs the frame number once, as #### or %%04d", a->exr);
+    if (a->png && veil_frame_pattern_kind(a->png) != 1)
+        return veil_cli_usage_error("--png: '%s' needs the frame number once, as #### or %%04d", a->png);
+    return -1;
+}
+
+static veil_render_opts opts_of(const tt_args* a, long frame, const veil_camera* cam)
+{
+    return (veil_render_opts){.width = (int)a->width, .height = (int)a->height, .step_voxels = a->step,
+                              .seed = veil_frame_seed((uint32_t)a->seed, frame), .method = a->method,
+                              .quality = a->quality, .sun_across = a->sun_across, .sun_along = a->sun_along,
+                              .camera = cam};
+}
+
+static int exists(const char* path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+int veil_cmd_turntable(int argc, char** argv)
+{
+    tt_args a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc >= 0) return rc;
+    veil_error err = {0};
+    veil_scene scene;
+    veil_result r = veil_scene_load(a.scene, &scene, &err);
+    if (r != VEIL_OK) return veil_cli_fail(r, &err);
+    long count = veil_frame_range_count(&a.range);
+    if (a.explain) {
+        veil_render_opts opts = opts_of(&a, a.range.first, NULL);
+        char* text = NULL;
+        long mine = (count - (a.shard - 1) + a.shards - 1) / a.shards; /* this shard's frames */
+        r = veil_plan_explain(&scene, &opts, mine > 0 ? mine : 1, &text, &err);
+        if (r == VEIL_OK) {
+            printf("frames %ld-%ld step %ld: %ld frames, shard %d/%d renders %ld of them\n", a.range.first, a.range.last,
+                   a.range.step, count, a.shard, a.shards, mine);
+            fputs(text, stdout);
+        }
+        free(text);
+        veil_scene_free(&scene);
+        if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
+        return r == VEIL_OK ? EXIT_OK : veil_cli_fail(r, &err);
+    }
+    /* the first frame's files stand for all: folders exist, no output is the scene or the other output */
+    char first_exr[4096], first_png[4096];
+    r = veil_frame_pattern_path(a.exr, a.range.first, first_exr, sizeof first_exr, &err);
+    if (r == VEIL_OK && a.png) r = veil_frame_pattern_path(a.png, a.range.first, first_png, sizeof first_png, &err);
+    if (r == VEIL_OK) {
+        const char* ins[1] = {a.scene};
+        const char* outs[2] = {first_exr, a.png ? first_png : NULL};
+        const char* names[2] = {"-o", "--png"};
+        rc = veil_cli_check_outputs(ins, 1, outs, names, 2);
+        if (rc != EXIT_OK) {
+            veil_scene_free(&scene);
+            return rc;
+        }
+        r = veil_cli_check_output_folder(first_exr, &err);
+    }
+    if (r == VEIL_OK && a.png) r = veil_cli_check_output_folder(first_png, &err);
+    if (r != VEIL_OK) {
+        veil_scene_free(&scene);
+        return veil_cli_fail(r, &err);
+    }
+    double t_start = veil_now_ms();
+    veil_gl* gl = NULL;
+    veil_renderer* ren = NULL;
+    veil_image_set im = {0};
+    long done = 0, skipped = 0;
+    for (long i = a.shard - 1; i < count && r == VEIL_OK; i += a.shards) {
+        long frame = veil_frame_range_at(&a.range, i);
+        char exr[4096], png[4096];
+        r = veil_frame_pattern_path(a.exr, frame, exr, sizeof exr, &err);
+        if (r == VEIL_OK && a.png) r = veil_frame_pattern_path(a.png, frame, png, sizeof png, &err);
+        if (r != VEIL_OK) break;
+        if (a.skip_existing && exists(exr) && (!a.png || exists(png))) { /* complete: frames are renamed into place */
+            ++skipped;
+            continue;
+        }
+        if (!gl) { /* made on the first frame to render: a rerun with every frame done needs no GPU */
+            r = veil_gl_create(NULL, &gl, &err);
+            if (r == VEIL_OK) r = veil_renderer_create(gl, &ren, &err);
+            if (r != VEIL_OK) break;
+        }
+        veil_camera cam = veil_orbit_camera(&scene.camera, &a.orbit, i, count);
+        veil_render_opts opts = opts_of(&a, frame, &cam);
+        veil_render_stats st = {0};
+        char label[96];
+        snprintf(label, sizeof label, "frame %ld (%ld of %ld)", frame, done + skipped + 1,
+                 (count - (a.shard - 1) + a.shards - 1) / a.shards);
+        veil_cli_progress_begin(label);
+        r = veil_render_scene_images(ren, &scene, &opts, &im, &st, &err);
+        veil_cli_progress_end();
+        if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
+        double t_write = veil_now_ms();
+        veil_cli_outputs out = {0}; /* the frame's files all or nothing, renamed into place */
+        const char* stage = r == VEIL_OK ? veil_cli_stage(&out, exr, &err) : NULL;
+        if (r == VEIL_OK) r = stage ? veil_image_set_write_exr(&im, stage, a.aovs, &err) : VEIL_ERR_IO;
+        stage = r == VEIL_OK && a.png ? veil_cli_stage(&out, png, &err) : NULL;
+        if (r == VEIL_OK && a.png) r = stage ? veil_write_png(stage, im.width, im.height, im.rgba, 0.0f, &err) : VEIL_ERR_IO;
+        veil_result c = veil_cli_commit(&out, r == VEIL_OK, &err);
+        if (r == VEIL_OK) r = c;
+        if (r != VEIL_OK) break;
+        ++done;
+        if (a.stats) {
+            printf("frame %ld\n", frame);
+            for (int k = 0; k < VEIL_STAGE_COUNT; ++k)
+                printf("%-10s %9.2f ms  (%s: %s)\n", veil_stage_name((veil_stage_id)k), st.stage[k].ms,
+                       veil_stage_status_name(st.stage[k].status), st.stage[k].why);
+            printf("write      %9.2f ms\n", veil_now_ms() - t_write);
+        }
+    }
+    if (r == VEIL_OK) {
+        char step[32] = "";
+        if (a.range.step > 1) snprintf(step, sizeof step, "x%ld", a.range.step);
+        printf("turntable: %ld frames rendered, %ld already there, shard %d/%d of frames %ld-%ld%s, in %.2f s\n",
+               done, skipped, a.shard, a.shards, a.range.first, a.range.last, step, (veil_now_ms() - t_start) * 1e-3);
+    }
+    veil_image_set_free(&im);
+    veil_renderer_destroy(ren);
+    veil_gl_destroy(gl);
+    veil_scene_free(&scene);
+    return r == VEIL_OK ? EXIT_OK : veil_cli_fail(r, &err);
+}
