@@ -22,7 +22,7 @@ typedef struct tt_args {
     const char *scene, *exr, *png;
     long width, height, seed, frames;
     veil_frame_range range;
-    int have_range, shard, shards, skip_existing, stats, explain, aovs;
+    int have_range, shard, shards, skip_existing, skip_missing, stats, explain, aovs;
     float step, sun_across, sun_along;
     veil_opv_method method;
     veil_quality quality;
@@ -48,6 +48,7 @@ static int parse_args(int argc, char** argv, tt_args* a)
         if (!strcmp(s, "--explain")) { a->explain = 1; continue; }
         if (!strcmp(s, "--aovs")) { a->aovs = 1; continue; }
         if (!strcmp(s, "--skip-existing")) { a->skip_existing = 1; continue; }
+        if (!strcmp(s, "--skip-missing")) { a->skip_missing = 1; continue; }
         if (s[0] != '-' || !s[1]) {
             if (a->scene) return veil_cli_usage_error("unexpected argument '%s'", s);
             a->scene = s;
@@ -140,6 +141,9 @@ int veil_cmd_turntable(int argc, char** argv)
         if (r == VEIL_OK) {
             printf("frames %ld-%ld step %ld: %ld frames, shard %d/%d renders %ld of them\n", a.range.first, a.range.last,
                    a.range.step, count, a.shard, a.shards, mine);
+            if (veil_scene_is_sequence(&scene))
+                printf("sequence: a source's file changes with the frame, so inject and propagate run on every frame "
+                       "(the plan below is the first frame's file, as if it stood still)\n");
             fputs(text, stdout);
         }
         free(text);
@@ -171,7 +175,7 @@ int veil_cmd_turntable(int argc, char** argv)
     veil_gl* gl = NULL;
     veil_renderer* ren = NULL;
     veil_image_set im = {0};
-    long done = 0, skipped = 0;
+    long done = 0, skipped = 0, missing = 0;
     for (long i = a.shard - 1; i < count && r == VEIL_OK; i += a.shards) {
         long frame = veil_frame_range_at(&a.range, i);
         char exr[4096], png[4096];
@@ -181,6 +185,17 @@ int veil_cmd_turntable(int argc, char** argv)
         if (a.skip_existing && exists(exr) && (!a.png || exists(png))) { /* complete: frames are renamed into place */
             ++skipped;
             continue;
+        }
+        r = veil_scene_set_frame(&scene, frame, &err); /* an animated source's file of this frame */
+        if (r == VEIL_ERR_IO && a.skip_missing) {
+            fprintf(stderr, "veil: %s: %s (skipped)\n", a.scene, err.msg);
+            r = VEIL_OK;
+            ++missing;
+            continue;
+        }
+        if (r != VEIL_OK) {
+            veil_cli_prefix_error(&err, a.scene);
+            break;
         }
         if (!gl) { /* made on the first frame to render: a rerun with every frame done needs no GPU */
             r = veil_gl_create(NULL, &gl, &err);
@@ -218,8 +233,11 @@ int veil_cmd_turntable(int argc, char** argv)
     if (r == VEIL_OK) {
         char step[32] = "";
         if (a.range.step > 1) snprintf(step, sizeof step, "x%ld", a.range.step);
-        printf("turntable: %ld frames rendered, %ld already there, shard %d/%d of frames %ld-%ld%s, in %.2f s\n",
-               done, skipped, a.shard, a.shards, a.range.first, a.range.last, step, (veil_now_ms() - t_start) * 1e-3);
+        char miss[64] = "";
+        if (missing) snprintf(miss, sizeof miss, ", %ld without their source files", missing);
+        printf("turntable: %ld frames rendered, %ld already there%s, shard %d/%d of frames %ld-%ld%s, in %.2f s\n",
+               done, skipped, miss, a.shard, a.shards, a.range.first, a.range.last, step,
+               (veil_now_ms() - t_start) * 1e-3);
     }
     veil_image_set_free(&im);
     veil_renderer_destroy(ren);

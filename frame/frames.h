@@ -11,6 +11,7 @@
 #include <stdint.h>
 
 #include "../core/result.h"
+#include "../scene/frame_pattern.h"
 #include "../scene/scene.h"
 
 /* Frames first, first + step, ... up to last (first <= last, step >= 1). */
@@ -34,16 +35,7 @@ long veil_frame_range_at(const veil_frame_range* r, long i);
  * i % N == I - 1. "I/N"; VEIL_ERR_INVALID otherwise. */
 veil_result veil_shard_parse(const char* text, int* index, int* count, veil_error* err);
 
-/* A file-name pattern holds the frame number once: a run of '#' (its
- * length the least number of digits, "####" -> 0042) or a printf
- * conversion "%d" / "%0Nd" (N <= 9). Returns 1 when `pattern` has one, 0
- * when it has none, -1 when it has two or a malformed '%' conversion
- * ("%%" is a literal '%'). */
-int veil_frame_pattern_kind(const char* pattern);
-/* The file of `frame` (negative frames get a '-' before the padded
- * digits). VEIL_ERR_INVALID when the pattern holds no single number,
- * VEIL_ERR_LIMIT when the name does not fit in n bytes. */
-veil_result veil_frame_pattern_path(const char* pattern, long frame, char* out, size_t n, veil_error* err);
+/* File-name patterns of frames: scene/frame_pattern.h. */
 
 /* An orbit of the camera about an axis through its look-at point. */
 typedef struct veil_orbit {

@@ -2,6 +2,7 @@
  * docs/scene-format.md): explicit RBF particles, seeded random particle
  * clouds, OpenVDB grids and analytic exponential fog. Private to io/. */
 #include "scene_sources.h"
+#include "../scene/frame_pattern.h"
 #include "particles.h"
 #include "../scene/limits.h"
 #include "particles_json.h"
@@ -14,7 +15,7 @@
 
 static const char* const SOURCE_TYPES[] = {"rbf", "rbf_random", "vdb", "exponential", NULL}; /* = veil_source_type */
 static const char* const VDB_KEYS[] = {"type", "file", "grid", "density_scale", "level_set", "emission", "temperature",
-                                       NULL};
+                                       "frame_offset", NULL};
 static const char* const TEMPERATURE_KEYS[] = {"grid", "scale", "offset", "intensity", NULL};
 static const char* const EMISSION_KEYS[] = {"grid", "scale", "color", NULL};
 static const char* const FOG_KEYS[] = {"type", "density", "falloff", "direction", "origin", "bounds", NULL};
@@ -80,8 +81,10 @@ static veil_result get_string(const ctx* c, const cJSON* o, const jpath* pp, con
     return VEIL_OK;
 }
 
-/* `file` resolved against the folder of the scene file, and checked readable. */
-static veil_result resolve_file(const ctx* c, const jpath* fp, char** file)
+/* `file` resolved against the folder of the scene file, and checked
+ * readable (unless `unchecked`: a sequence's pattern, whose frames are
+ * checked as they are needed). */
+static veil_result resolve_path(const ctx* c, const jpath* fp, char** file, int unchecked)
 {
     const char* slash = strrchr(c->name, '/');
     if ((*file)[0] != '/' && slash) {
@@ -93,11 +96,14 @@ static veil_result resolve_file(const ctx* c, const jpath* fp, char** file)
         free(*file);
         *file = joined;
     }
+    if (unchecked) return VEIL_OK;
     FILE* f = fopen(*file, "rb");
     if (!f) return veil__jr_fail_at(c, fp, "cannot open '%s': %s", *file, strerror(errno));
     fclose(f);
     return VEIL_OK;
 }
+
+static veil_result resolve_file(const ctx* c, const jpath* fp, char** file) { return resolve_path(c, fp, file, 0); }
 
 /* "rbf": inline "particles", or a particle "file" (docs/particles.md) read now. */
 static veil_result parse_rbf(const ctx* c, const cJSON* so, const jpath* sp, veil_source* src)
@@ -133,7 +139,32 @@ static veil_result parse_vdb(const ctx* c, const cJSON* so, const jpath* sp, vei
 {
     const jpath fp = {sp, "file", 0}, lp = {sp, "level_set", 0};
     TRY(get_string(c, so, sp, "file", true, &v->file));
-    TRY(resolve_file(c, &fp, &v->file));
+    int kind = veil_frame_pattern_kind(v->file);
+    if (kind < 0)
+        return veil__jr_fail_at(c, &fp, "'%s': a sequence's file holds the frame number once, as #### or %%04d "
+                                "(a literal '%%' is written %%%%)", v->file);
+    if (kind == 1) { /* a sequence: frame 1's file until veil_scene_set_frame() says otherwise */
+        TRY(resolve_path(c, &fp, &v->file, 1));
+        v->sequence = v->file;
+        v->file = NULL;
+        double off = 0.0;
+        TRY(veil__jr_get_number(c, so, sp, "frame_offset", false, &VEIL__R_ANY, &off));
+        if (off != floor(off) || fabs(off) > 1e9)
+            return veil__jr_fail_at(c, &(jpath){sp, "frame_offset", 0}, "expected a whole number of frames within 1e9, "
+                                    "got %g", off);
+        v->frame_offset = (long)off;
+        char first[4096];
+        veil_result r = veil_frame_pattern_path(v->sequence, 1 + v->frame_offset, first, sizeof first, c->err);
+        if (r != VEIL_OK) return r;
+        size_t len = strlen(first) + 1;
+        v->file = malloc(len);
+        if (v->file) memcpy(v->file, first, len);
+        if (!v->file) return veil_fail(c->err, VEIL_ERR_OOM, "%s: out of memory", c->name);
+    } else {
+        if (cJSON_GetObjectItemCaseSensitive(so, "frame_offset"))
+            return veil__jr_fail_at(c, &(jpath){sp, "frame_offset", 0}, "only for a sequence (a file with #### or %%04d)");
+        TRY(resolve_file(c, &fp, &v->file));
+    }
     TRY(get_string(c, so, sp, "grid", false, &v->grid));
     double scale = 1.0;
     TRY(veil__jr_get_number(c, so, sp, "density_scale", false, &VEIL__R_NONNEG, &scale));

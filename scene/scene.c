@@ -1,8 +1,12 @@
 /* veil — releasing a scene, and the particles its sources describe. */
 #include "scene.h"
 
+#include <errno.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "frame_pattern.h"
 
 void veil_scene_free(veil_scene* s)
 {
@@ -10,6 +14,7 @@ void veil_scene_free(veil_scene* s)
     for (size_t i = 0; i < s->medium.source_count; ++i) {
         free(s->medium.sources[i].particles);
         free(s->medium.sources[i].vdb.file);
+        free(s->medium.sources[i].vdb.sequence);
         free(s->medium.sources[i].vdb.grid);
         free(s->medium.sources[i].vdb.emission_grid);
         free(s->medium.sources[i].vdb.temperature_grid);
@@ -134,4 +139,35 @@ int veil_quality_parse(const char* name, veil_quality* out)
             return 1;
         }
     return 0;
+}
+
+int veil_scene_is_sequence(const veil_scene* s)
+{
+    for (size_t i = 0; i < s->medium.source_count; ++i)
+        if (s->medium.sources[i].type == VEIL_SOURCE_VDB && s->medium.sources[i].vdb.sequence) return 1;
+    return 0;
+}
+
+veil_result veil_scene_set_frame(veil_scene* s, long frame, veil_error* err)
+{
+    for (size_t i = 0; i < s->medium.source_count; ++i) {
+        veil_vdb_source* v = &s->medium.sources[i].vdb;
+        if (s->medium.sources[i].type != VEIL_SOURCE_VDB || !v->sequence) continue;
+        char path[4096];
+        long f = frame + v->frame_offset;
+        veil_result r = veil_frame_pattern_path(v->sequence, f, path, sizeof path, err);
+        if (r != VEIL_OK) return r;
+        FILE* fp = fopen(path, "rb");
+        if (!fp)
+            return veil_fail(err, VEIL_ERR_IO, "medium.sources[%zu].file: frame %ld: cannot open '%s': %s", i, frame,
+                             path, strerror(errno));
+        fclose(fp);
+        size_t len = strlen(path) + 1;
+        char* copy = malloc(len);
+        if (copy) memcpy(copy, path, len);
+        if (!copy) return veil_fail(err, VEIL_ERR_OOM, "out of memory");
+        free(v->file);
+        v->file = copy;
+    }
+    return VEIL_OK;
 }

@@ -49,7 +49,10 @@ typedef enum veil_source_type {
 
 /* An OpenVDB float grid ({"type":"vdb", ...}). */
 typedef struct veil_vdb_source {
-    char* file;          /* resolved against the scene's folder (owned) */
+    char* file;          /* resolved against the scene's folder (owned); for a sequence, the current frame's */
+    char* sequence;      /* the file's frame pattern when "file" holds one ("smoke.####.vdb"), resolved
+                            (owned); NULL: one file for every frame. veil_scene_set_frame() sets `file` */
+    long frame_offset;   /* "frame_offset": the file of frame f is the pattern's frame f + frame_offset */
     char* grid;          /* grid name, or NULL: "density", else the first float grid (owned) */
     float density_scale; /* multiplies the grid's values; default 1 */
     int level_set_to_fog; /* "level_set": "to_fog": convert a level set instead of refusing it */
@@ -233,6 +236,14 @@ typedef struct veil_scene {
 } veil_scene;
 
 void veil_scene_free(veil_scene* s); /* accepts NULL and zeroed scenes */
+
+/* Points every sequence source of s at its file for frame `frame`
+ * (pattern frame + frame_offset). VEIL_ERR_IO naming the source, the frame
+ * and the file when that file cannot be read; s is left pointing at the
+ * frames it could set. A scene without sequences is left as it is. */
+veil_result veil_scene_set_frame(veil_scene* s, long frame, veil_error* err);
+/* 1 when some source of s is a sequence. */
+int veil_scene_is_sequence(const veil_scene* s);
 
 /* All particles of all RBF sources (explicit and generated), newly
  * allocated into *out (free() it). */

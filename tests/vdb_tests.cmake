@@ -155,3 +155,7 @@ foreach(field emission temperature)
                    "medium.sources[0].${field}.grid: ${VDB_DATA}/emissive_slab.vdb: no grid named 'nope'")
   set_tests_properties(bad_input_${field}_grid PROPERTIES FIXTURES_REQUIRED vdb_data LABELS bad_input)
 endforeach()
+# An animated source: one VDB a frame through veil turntable (tests/turntable_sequence.sh).
+add_test(NAME cli_turntable_sequence
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/turntable_sequence.sh $<TARGET_FILE:veil_cli> ${VDB_DATA})
+set_tests_properties(cli_turntable_sequence PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "gpu;cli" SKIP_RETURN_CODE 77)
