@@ -11,12 +11,14 @@
 #include "commands.h"
 #include "progress.h"
 #include "core/clock.h"
+#include "core/hash.h"
 #include "frame/frames.h"
 #include "frame/plan.h"
 #include "frame/renderer.h"
 #include "gpu/gl_context.h"
 #include "io/image.h"
 #include "io/scene.h"
+#include "scene/camera.h"
 
 typedef struct tt_args {
     const char *scene, *exr, *png;
@@ -117,6 +119,19 @@ static veil_render_opts opts_of(const tt_args* a, long frame, const veil_camera*
                               .camera = cam};
 }
 
+/* FNV-1a of the scene file's bytes (0 when it cannot be read: it was, a moment ago). */
+static uint64_t file_hash(const char* path)
+{
+    FILE* f = fopen(path, "rb");
+    if (!f) return 0;
+    uint64_t h = VEIL_FNV_OFFSET;
+    unsigned char buf[65536];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0) h = veil_hash_bytes(h, buf, n);
+    fclose(f);
+    return h;
+}
+
 static int exists(const char* path)
 {
     struct stat st;
@@ -172,6 +187,7 @@ int veil_cmd_turntable(int argc, char** argv)
         return veil_cli_fail(r, &err);
     }
     double t_start = veil_now_ms();
+    const uint64_t scene_hash = file_hash(a.scene);
     veil_gl* gl = NULL;
     veil_renderer* ren = NULL;
     veil_image_set im = {0};
@@ -213,9 +229,27 @@ int veil_cmd_turntable(int argc, char** argv)
         veil_cli_progress_end();
         if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
         double t_write = veil_now_ms();
+        /* the header a compositor reads: the frame, the camera, what made the image */
+        veil_render_opts used = veil_render_opts_resolve(&opts, &scene);
+        veil_exr_meta meta = {.has_frame = 1, .frame = (int)frame};
+        veil_camera_basis basis;
+        if (r == VEIL_OK && veil_camera_make_basis(&cam, used.width, used.height, &basis, NULL) == VEIL_OK) {
+            veil_camera_exr_matrices(&basis, meta.world_to_camera, meta.world_to_ndc);
+            meta.has_camera = 1;
+        }
+        char hash[32], settings[256], software[64];
+        snprintf(hash, sizeof hash, "%016llx", (unsigned long long)scene_hash);
+        snprintf(settings, sizeof settings, "quality %s, step %g voxels, method %s, od-spacing %g,%g, seed %u, %dx%d",
+                 veil_quality_name(used.quality), used.step_voxels, veil_opv_method_name(used.method), used.sun_across,
+                 used.sun_along, used.seed, used.width, used.height);
+        snprintf(software, sizeof software, "veil %s", VEIL_VERSION);
+        const char* strings[4][2] = {{"software", software}, {"veil:scene", a.scene}, {"veil:sceneHash", hash},
+                                     {"veil:settings", settings}};
+        memcpy(meta.strings, strings, sizeof strings);
+        meta.n_strings = 4;
         veil_cli_outputs out = {0}; /* the frame's files all or nothing, renamed into place */
         const char* stage = r == VEIL_OK ? veil_cli_stage(&out, exr, &err) : NULL;
-        if (r == VEIL_OK) r = stage ? veil_image_set_write_exr(&im, stage, a.aovs, &err) : VEIL_ERR_IO;
+        if (r == VEIL_OK) r = stage ? veil_image_set_write_exr_meta(&im, stage, a.aovs, &meta, &err) : VEIL_ERR_IO;
         stage = r == VEIL_OK && a.png ? veil_cli_stage(&out, png, &err) : NULL;
         if (r == VEIL_OK && a.png) r = stage ? veil_write_png(stage, im.width, im.height, im.rgba, 0.0f, &err) : VEIL_ERR_IO;
         veil_result c = veil_cli_commit(&out, r == VEIL_OK, &err);

@@ -53,6 +53,7 @@ typedef struct write_job {
     int width, height, n;
     const char* const* names;
     const float* const* planes; /* n planes of width*height */
+    const veil_exr_meta* meta;  /* header attributes, or NULL */
 } write_job;
 
 static exr_result_t write_chunks(exr_context_t ctx, int part, const write_job* job, const char** stage)
@@ -103,6 +104,23 @@ static exr_result_t write_chunks(exr_context_t ctx, int part, const write_job* j
     return rv;
 }
 
+static exr_result_t write_meta(exr_context_t ctx, int part, const veil_exr_meta* m)
+{
+    exr_result_t rv = EXR_ERR_SUCCESS;
+    if (!m) return rv;
+    if (m->has_frame) rv = exr_attr_set_int(ctx, part, "frame", m->frame);
+    if (rv == EXR_ERR_SUCCESS && m->has_camera) {
+        exr_attr_m44f_t wc, wn;
+        memcpy(wc.m, m->world_to_camera, sizeof wc.m);
+        memcpy(wn.m, m->world_to_ndc, sizeof wn.m);
+        rv = exr_attr_set_m44f(ctx, part, "worldToCamera", &wc);
+        if (rv == EXR_ERR_SUCCESS) rv = exr_attr_set_m44f(ctx, part, "worldToNDC", &wn);
+    }
+    for (int i = 0; i < m->n_strings && i < VEIL_EXR_META_STRINGS && rv == EXR_ERR_SUCCESS; ++i)
+        if (m->strings[i][0] && m->strings[i][1]) rv = exr_attr_set_string(ctx, part, m->strings[i][0], m->strings[i][1]);
+    return rv;
+}
+
 static exr_result_t write_exr_stream(const char* path, int fd, const write_job* job, const char** stage)
 {
     fd_stream stream = {fd, -1};
@@ -125,6 +143,7 @@ static exr_result_t write_exr_stream(const char* path, int fd, const write_job* 
     }
     if (rv == EXR_ERR_SUCCESS)
         rv = exr_initialize_required_attr_simple(ctx, part, job->width, job->height, EXR_COMPRESSION_ZIP);
+    if (rv == EXR_ERR_SUCCESS) rv = write_meta(ctx, part, job->meta);
     for (int c = 0; c < job->n && rv == EXR_ERR_SUCCESS; ++c)
         rv = exr_add_channel(ctx, part, job->names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
     if (rv == EXR_ERR_SUCCESS) {
@@ -173,6 +192,12 @@ static veil_result check_channels(const char* path, int n, const char* const* na
 veil_result veil_write_exr_planes(const char* path, int width, int height, int n, const char* const* names,
                                   const float* const* planes, veil_error* err)
 {
+    return veil_write_exr_planes_meta(path, width, height, n, names, planes, NULL, err);
+}
+
+veil_result veil_write_exr_planes_meta(const char* path, int width, int height, int n, const char* const* names,
+                                       const float* const* planes, const veil_exr_meta* meta, veil_error* err)
+{
     if (!path || !*path) return veil_fail(err, VEIL_ERR_INVALID, "veil_write_exr_planes: no output path given");
     veil_result result = check_size(path, width, height, 1, err);
     if (result == VEIL_OK) result = check_channels(path, n, names, planes, err);
@@ -190,7 +215,7 @@ veil_result veil_write_exr_planes(const char* path, int width, int height, int n
     exr_msgs* saved = veil__exr_tls_msgs;
     veil__exr_tls_msgs = &msgs;
     const char* stage = "";
-    const write_job job = {width, height, n, names, planes};
+    const write_job job = {width, height, n, names, planes, meta};
     exr_result_t rv = write_exr_stream(path, fd, &job, &stage);
     veil__exr_tls_msgs = saved;
 

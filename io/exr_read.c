@@ -332,6 +332,41 @@ static veil_result read_channels(exr_const_context_t ctx, const char* path, uint
 
 /* Opens `path` and reads the channels `req` asks for; `fn` names the
  * public function in messages about its arguments. */
+/* Opens path (a regular file) and starts OpenEXRCore reading it through
+ * *stream (fd and size), the error messages going to *msgs (installed as
+ * veil__exr_tls_msgs: the caller restores *saved after exr_finish and
+ * closes stream->fd, both also on failure when stream->fd >= 0). */
+static veil_result start_read(const char* path, fd_stream* stream, exr_context_t* ctx, exr_msgs* msgs,
+                              exr_msgs** saved, veil_error* err)
+{
+    *ctx = NULL;
+    stream->fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (stream->fd < 0) return veil_fail(err, VEIL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    const int stat_errno = fstat(stream->fd, &st) != 0 ? errno : 0;
+    if (stat_errno || !S_ISREG(st.st_mode)) {
+        close(stream->fd);
+        stream->fd = -1;
+        if (stat_errno) return veil_fail(err, VEIL_ERR_IO, "%s: cannot stat: %s", path, strerror(stat_errno));
+        return veil_fail(err, VEIL_ERR_IO, "%s: not a regular file", path);
+    }
+    stream->size = (int64_t)st.st_size;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = veil__exr_on_error;
+    init.user_data = stream;
+    init.read_fn = veil__exr_fd_read;
+    init.size_fn = veil__exr_fd_size;
+    /* A damaged chunk table is an error, not something to search around. */
+    init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
+    *saved = veil__exr_tls_msgs;
+    veil__exr_tls_msgs = msgs;
+    exr_result_t rv = exr_start_read(ctx, path, &init);
+    if (rv != EXR_ERR_SUCCESS)
+        return veil_fail(err, VEIL_ERR_IO, "%s: not a readable OpenEXR file: %s [%s]", path, veil__exr_reason(msgs, rv),
+                         exr_get_error_code_as_string(rv));
+    return VEIL_OK;
+}
+
 static veil_result read_exr_file(const char* fn, const char* path, const read_request* req, int* width, int* height,
                                  float** out, veil_error* err)
 {
@@ -345,41 +380,15 @@ static veil_result read_exr_file(const char* fn, const char* path, const read_re
         if (!req->names[k] || !req->names[k][0])
             return veil_fail(err, VEIL_ERR_INVALID, "%s: %s: no channel name given", path, fn);
 
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return veil_fail(err, VEIL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    struct stat st;
-    const int stat_errno = fstat(fd, &st) != 0 ? errno : 0;
-    if (stat_errno || !S_ISREG(st.st_mode)) {
-        close(fd);
-        if (stat_errno) return veil_fail(err, VEIL_ERR_IO, "%s: cannot stat: %s", path, strerror(stat_errno));
-        return veil_fail(err, VEIL_ERR_IO, "%s: not a regular file", path);
-    }
-
-    fd_stream stream = {fd, (int64_t)st.st_size};
-    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = veil__exr_on_error;
-    init.user_data = &stream;
-    init.read_fn = veil__exr_fd_read;
-    init.size_fn = veil__exr_fd_size;
-    /* A damaged chunk table is an error, not something to search around. */
-    init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
-
+    fd_stream stream = {-1, 0};
     exr_msgs msgs = {{0}, 0};
     exr_msgs* saved = veil__exr_tls_msgs;
-    veil__exr_tls_msgs = &msgs;
-
-    veil_result r;
     exr_context_t ctx = NULL;
-    exr_result_t rv = exr_start_read(&ctx, path, &init);
-    if (rv != EXR_ERR_SUCCESS) {
-        r = veil_fail(err, VEIL_ERR_IO, "%s: not a readable OpenEXR file: %s [%s]", path, veil__exr_reason(&msgs, rv),
-                      exr_get_error_code_as_string(rv));
-    } else {
-        r = read_channels(ctx, path, (uint64_t)st.st_size, req, width, height, out, &msgs, err);
-    }
+    veil_result r = start_read(path, &stream, &ctx, &msgs, &saved, err);
+    if (r == VEIL_OK) r = read_channels(ctx, path, (uint64_t)stream.size, req, width, height, out, &msgs, err);
     if (ctx) exr_finish(&ctx);
     veil__exr_tls_msgs = saved;
-    close(fd);
+    if (stream.fd >= 0) close(stream.fd);
     return r;
 }
 
@@ -395,4 +404,38 @@ veil_result veil_read_exr_channel(const char* path, const char* name, int* width
     const char* const names[1] = {name};
     const read_request req = {1, names, -1, VEIL_ERR_INVALID, ""};
     return read_exr_file("veil_read_exr_channel", path, &req, width, height, plane, err);
+}
+
+veil_result veil_read_exr_meta(const char* path, int* has_frame, int* frame, int* has_camera, float world_to_camera[16],
+                               float world_to_ndc[16], const char* name, char* value, size_t n, veil_error* err)
+{
+    *has_frame = *has_camera = 0;
+    if (value && n) value[0] = '\0';
+    fd_stream stream = {-1, 0};
+    exr_msgs msgs = {{0}, 0};
+    exr_msgs* saved = veil__exr_tls_msgs;
+    exr_context_t ctx = NULL;
+    veil_result r = start_read(path, &stream, &ctx, &msgs, &saved, err);
+    if (r == VEIL_OK) {
+        int32_t f;
+        if (exr_attr_get_int(ctx, 0, "frame", &f) == EXR_ERR_SUCCESS) *has_frame = 1, *frame = f;
+        exr_attr_m44f_t wc, wn;
+        if (exr_attr_get_m44f(ctx, 0, "worldToCamera", &wc) == EXR_ERR_SUCCESS &&
+            exr_attr_get_m44f(ctx, 0, "worldToNDC", &wn) == EXR_ERR_SUCCESS) {
+            *has_camera = 1;
+            memcpy(world_to_camera, wc.m, sizeof wc.m);
+            memcpy(world_to_ndc, wn.m, sizeof wn.m);
+        }
+        const char* s = NULL;
+        int32_t len = 0;
+        if (name && value && n && exr_attr_get_string(ctx, 0, name, &len, &s) == EXR_ERR_SUCCESS && s) {
+            size_t k = (size_t)len < n - 1 ? (size_t)len : n - 1;
+            memcpy(value, s, k);
+            value[k] = '\0';
+        }
+    }
+    if (ctx) exr_finish(&ctx);
+    veil__exr_tls_msgs = saved;
+    if (stream.fd >= 0) close(stream.fd);
+    return r;
 }

@@ -25,6 +25,33 @@ veil_result veil_write_exr(const char* path, int width, int height,
 veil_result veil_write_exr_planes(const char* path, int width, int height, int n, const char* const* names,
                                   const float* const* planes, veil_error* err);
 
+/* Header attributes a compositor reads, written beside the channels (all
+ * optional; NULL or zero fields: none). Matrices in OpenEXR's convention:
+ * row vectors, p' = p M; worldToCamera into a left-handed camera space
+ * (x right, y up, z the viewing direction), worldToNDC onto the image
+ * (0, 0) top left, (1, 1) bottom right, after the division by w. */
+#define VEIL_EXR_META_STRINGS 8
+typedef struct veil_exr_meta {
+    int has_frame;
+    int frame;                    /* int attribute "frame" */
+    int has_camera;
+    float world_to_camera[16];    /* m44f "worldToCamera", row-major */
+    float world_to_ndc[16];       /* m44f "worldToNDC", row-major */
+    const char* strings[VEIL_EXR_META_STRINGS][2]; /* string attributes: name, value */
+    int n_strings;
+} veil_exr_meta;
+
+/* veil_write_exr_planes with header attributes (meta may be NULL). */
+veil_result veil_write_exr_planes_meta(const char* path, int width, int height, int n, const char* const* names,
+                                       const float* const* planes, const veil_exr_meta* meta, veil_error* err);
+
+/* Reads header attributes back: the int "frame" (*has_frame 0 when absent),
+ * the two camera matrices (*has_camera 0 when either is absent) and the
+ * string attribute `name` into value (n bytes; "" when absent; NULL name:
+ * none). VEIL_ERR_IO naming the file when it cannot be read. */
+veil_result veil_read_exr_meta(const char* path, int* has_frame, int* frame, int* has_camera, float world_to_camera[16],
+                               float world_to_ndc[16], const char* name, char* value, size_t n, veil_error* err);
+
 /* Reads one named channel (half or float, case-sensitive name) of an EXR,
  * scanline or tiled as veil_read_exr, as float into a newly malloc'd
  * width*height plane (free() it); VEIL_ERR_INVALID naming the file and

@@ -42,19 +42,26 @@ void veil_image_set_plane(const veil_image_set* s, int c, float* out)
 
 veil_result veil_image_set_write_exr(const veil_image_set* s, const char* path, int aovs, veil_error* err)
 {
-    if (!aovs) return veil_write_exr(path, s->width, s->height, s->rgba, err);
+    return veil_image_set_write_exr_meta(s, path, aovs, NULL, err);
+}
+
+veil_result veil_image_set_write_exr_meta(const veil_image_set* s, const char* path, int aovs,
+                                          const veil_exr_meta* meta, veil_error* err)
+{
+    if (!aovs && !meta) return veil_write_exr(path, s->width, s->height, s->rgba, err);
+    const int channels = aovs ? VEIL_IMAGE_SET_CHANNELS : 4; /* without the AOVs: R, G, B, A, the first four */
     size_t n = (size_t)s->width * (size_t)s->height, bytes;
-    if (!veil_mul_sizes(n, VEIL_IMAGE_SET_CHANNELS, sizeof(float), 1, &bytes))
+    if (!veil_mul_sizes(n, (size_t)channels, sizeof(float), 1, &bytes))
         return veil_fail(err, VEIL_ERR_LIMIT, "%s: a %dx%d image set is too large", path, s->width, s->height);
     float* all = malloc(bytes);
     if (!all) return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory for the image set's planes", path);
     const float* planes[VEIL_IMAGE_SET_CHANNELS];
-    for (int c = 0; c < VEIL_IMAGE_SET_CHANNELS; ++c) {
+    for (int c = 0; c < channels; ++c) {
         veil_image_set_plane(s, c, all + (size_t)c * n);
         planes[c] = all + (size_t)c * n;
     }
-    veil_result r = veil_write_exr_planes(path, s->width, s->height, VEIL_IMAGE_SET_CHANNELS,
-                                          veil_image_set_channel_names, planes, err);
+    veil_result r = veil_write_exr_planes_meta(path, s->width, s->height, channels, veil_image_set_channel_names,
+                                               planes, meta, err);
     free(all);
     return r;
 }

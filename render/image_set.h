@@ -25,6 +25,7 @@
 #define VEIL_IMAGE_SET_H
 
 #include "../core/result.h"
+#include "../io/image.h"
 
 typedef struct veil_image_set {
     int width, height;
@@ -52,5 +53,8 @@ void veil_image_set_plane(const veil_image_set* s, int c, float* out);
 /* Writes the set to an EXR: R, G, B, A, plus the AOV channels when aovs is
  * non-zero. All or nothing, as every writer in io/. */
 veil_result veil_image_set_write_exr(const veil_image_set* s, const char* path, int aovs, veil_error* err);
+/* The same with header attributes (io/image.h; NULL: none). */
+veil_result veil_image_set_write_exr_meta(const veil_image_set* s, const char* path, int aovs,
+                                          const veil_exr_meta* meta, veil_error* err);
 
 #endif

@@ -64,3 +64,33 @@ veil_camera veil_camera_of_frame(const veil_camera* c, long frame, long frames)
 {
     return veil_camera_orbit(c, frames > 1 ? 2.0 * VEIL_PI * (double)frame / (double)frames : 0.0);
 }
+
+void veil_camera_exr_matrices(const veil_camera_basis* b, float world_to_camera[16], float world_to_ndc[16])
+{
+    double axis[3][3], len[3]; /* unit right, up, forward; right and up's lengths are tan(fov_x / 2), tan(fov_y / 2) */
+    const float* v[3] = {b->right, b->up, b->fwd};
+    for (int k = 0; k < 3; ++k) {
+        len[k] = sqrt((double)v[k][0] * v[k][0] + (double)v[k][1] * v[k][1] + (double)v[k][2] * v[k][2]);
+        for (int a = 0; a < 3; ++a) axis[k][a] = v[k][a] / len[k];
+    }
+    double wc[4][4] = {{0}}, p[4][4] = {{0}};
+    for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k) wc[i][k] = axis[k][i]; /* p_cam[k] = (p - pos) . axis[k] */
+    for (int k = 0; k < 3; ++k)
+        wc[3][k] = -(b->pos[0] * axis[k][0] + b->pos[1] * axis[k][1] + b->pos[2] * axis[k][2]);
+    wc[3][3] = 1.0;
+    /* ndc_x = 1/2 + x / (2 z tan_x), ndc_y = 1/2 - y / (2 z tan_y): X = x / (2 tan_x) + z / 2, Y = -y / (2 tan_y) + z / 2,
+     * Z = 1 (ndc z = 1/depth), W = z */
+    p[0][0] = 0.5 / len[0];
+    p[1][1] = -0.5 / len[1];
+    p[2][0] = p[2][1] = 0.5;
+    p[2][3] = 1.0;
+    p[3][2] = 1.0;
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+            double sum = 0.0;
+            for (int k = 0; k < 4; ++k) sum += wc[i][k] * p[k][j];
+            world_to_camera[4 * i + j] = (float)wc[i][j];
+            world_to_ndc[4 * i + j] = (float)sum;
+        }
+}

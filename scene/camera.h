@@ -27,4 +27,11 @@ veil_camera veil_camera_of_frame(const veil_camera* c, long frame, long frames);
 
 void veil_camera_ray(const veil_camera_basis* b, int width, int height, int px, int py, float dir[3]);
 
+/* The camera as OpenEXR's header matrices (io/image.h, veil_exr_meta; row
+ * vectors, row-major): worldToCamera into x right, y up, z the viewing
+ * direction; worldToNDC onto the image, (0, 0) its top-left corner and
+ * (1, 1) its bottom-right, after dividing by w (= the depth along z), with
+ * the pixel centres where veil_camera_ray shoots. */
+void veil_camera_exr_matrices(const veil_camera_basis* b, float world_to_camera[16], float world_to_ndc[16]);
+
 #endif

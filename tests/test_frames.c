@@ -1,13 +1,24 @@
+#define _POSIX_C_SOURCE 200809L
 /* Frames of a sequence (frame/frames.h): ranges, shards, file-name
  * patterns, the orbit's cameras and the per-frame seeds. The orbit is
  * checked against what it must keep: the distance to the look-at point
  * (rounding of a float position of magnitude <= 10: 1e-5 relative), the
- * angle between consecutive frames (degrees / count), the elevation. */
+ * angle between consecutive frames (degrees / count), the elevation.
+ * A frame's EXR header: the camera matrices put the look-at point at the
+ * image's centre and each pixel's ray through its centre (float
+ * arithmetic on coordinates of magnitude <= 10: 1e-5 of the image), and
+ * they, the frame and the strings read back as written, bit for bit. */
 #include <math.h>
 #include <string.h>
 
+#include <stdio.h>
+#include <stdlib.h>
+#include <unistd.h>
+
 #include "check.h"
 #include "frame/frames.h"
+#include "io/image.h"
+#include "scene/camera.h"
 
 static void test_ranges(void)
 {
@@ -105,8 +116,70 @@ static void test_seeds(void)
     CHECK(veil_frame_seed(1, 5) != veil_frame_seed(2, 5), "the base seed matters");
 }
 
+static void test_header(void)
+{
+    veil_camera c = {.position = {1, 2, 6}, .look_at = {1, 1, 0}, .up = {0, 1, 0}, .fov_y_deg = 40};
+    const int w = 64, h = 48;
+    veil_camera_basis b;
+    veil_error err = {0};
+    CHECK(veil_camera_make_basis(&c, w, h, &b, &err) == VEIL_OK, "%s", err.msg);
+    veil_exr_meta m = {.has_frame = 1, .frame = 1042, .has_camera = 1, .n_strings = 1,
+                       .strings = {{"veil:settings", "quality default"}}};
+    veil_camera_exr_matrices(&b, m.world_to_camera, m.world_to_ndc);
+    /* row vectors: p' = (p, 1) M */
+    double cam[4] = {0}, ndc[4] = {0};
+    const float* p = c.look_at;
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+            double pi = i < 3 ? p[i] : 1.0;
+            cam[j] += pi * m.world_to_camera[4 * i + j];
+            ndc[j] += pi * m.world_to_ndc[4 * i + j];
+        }
+    double d = sqrt(37.0);
+    CHECK(fabs(cam[0]) < 1e-5 && fabs(cam[1]) < 1e-5 && fabs(cam[2] - d) < 1e-5,
+          "the look-at point in camera space: (%g, %g, %g), want (0, 0, %g)", cam[0], cam[1], cam[2], d);
+    CHECK(fabs(ndc[0] / ndc[3] - 0.5) < 1e-5 && fabs(ndc[1] / ndc[3] - 0.5) < 1e-5, "the look-at point at NDC (%g, %g)",
+          ndc[0] / ndc[3], ndc[1] / ndc[3]);
+    const int px[3][2] = {{0, 0}, {63, 47}, {10, 30}};
+    for (int k = 0; k < 3; ++k) {
+        float dir[3];
+        veil_camera_ray(&b, w, h, px[k][0], px[k][1], dir);
+        double x[4] = {b.pos[0] + 3.0 * dir[0], b.pos[1] + 3.0 * dir[1], b.pos[2] + 3.0 * dir[2], 1.0}, q[4] = {0};
+        for (int j = 0; j < 4; ++j)
+            for (int i = 0; i < 4; ++i) q[j] += x[i] * m.world_to_ndc[4 * i + j];
+        double want_x = (px[k][0] + 0.5) / w, want_y = (px[k][1] + 0.5) / h;
+        CHECK(fabs(q[0] / q[3] - want_x) < 1e-5 && fabs(q[1] / q[3] - want_y) < 1e-5,
+              "pixel (%d, %d)'s ray meets NDC (%g, %g), want (%g, %g)", px[k][0], px[k][1], q[0] / q[3], q[1] / q[3],
+              want_x, want_y);
+    }
+    char path[] = "/tmp/veil_test_header_XXXXXX";
+    int fd = mkstemp(path);
+    CHECK(fd >= 0, "mkstemp");
+    if (fd < 0) return;
+    close(fd);
+    float plane[12] = {0};
+    const float* planes[1] = {plane};
+    const char* names[1] = {"R"};
+    CHECK(veil_write_exr_planes_meta(path, 4, 3, 1, names, planes, &m, &err) == VEIL_OK, "%s", err.msg);
+    int has_frame = 0, frame = 0, has_camera = 0;
+    float wc[16], wn[16];
+    char value[64];
+    CHECK(veil_read_exr_meta(path, &has_frame, &frame, &has_camera, wc, wn, "veil:settings", value, sizeof value,
+                             &err) == VEIL_OK, "%s", err.msg);
+    CHECK(has_frame && frame == 1042, "frame %d (%d)", frame, has_frame);
+    CHECK(has_camera && !memcmp(wc, m.world_to_camera, sizeof wc) && !memcmp(wn, m.world_to_ndc, sizeof wn),
+          "the matrices did not come back as written");
+    CHECK(!strcmp(value, "quality default"), "the settings string: '%s'", value);
+    CHECK(veil_write_exr_planes(path, 4, 3, 1, names, planes, &err) == VEIL_OK, "%s", err.msg);
+    CHECK(veil_read_exr_meta(path, &has_frame, &frame, &has_camera, wc, wn, "veil:settings", value, sizeof value,
+                             &err) == VEIL_OK && !has_frame && !has_camera && !value[0],
+          "a file written without a header's attributes has them");
+    unlink(path);
+}
+
 int main(void)
 {
+    test_header();
     test_ranges();
     test_patterns();
     test_orbit();

@@ -40,6 +40,10 @@ for f in 1001 1003 1005 1007; do
   cmp -s "$tmp/one/t.$f.png" "$tmp/two/t.$f.png" || fail "frame $f's PNG differs between one run and two shards"
 done
 ls "$tmp/one" | grep -q '1002' && fail "a frame off the range's step was written"
+# the header a compositor reads (test_frames checks the values; here, that the command writes them)
+for attr in frame worldToCamera worldToNDC veil:sceneHash veil:settings software; do
+  head -c 4096 "$tmp/one/t.1003.exr" | grep -a -q "$attr" || fail "frame 1003's header lacks $attr"
+done
 cmp -s "$tmp/one/t.1001.exr" "$tmp/one/t.1003.exr" && fail "frames 1001 and 1003 are the same image"
 
 # --skip-existing: remove one frame, rerun: only it is rendered, the others keep their bytes and times
