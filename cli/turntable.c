@@ -10,6 +10,7 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "progress.h"
+#include "review.h"
 #include "core/clock.h"
 #include "core/hash.h"
 #include "frame/frames.h"
@@ -21,7 +22,8 @@
 #include "scene/camera.h"
 
 typedef struct tt_args {
-    const char *scene, *exr, *png;
+    const char *scene, *exr, *png, *movie, *sheet;
+    float fps;
     long width, height, seed, frames;
     veil_frame_range range;
     int have_range, shard, shards, skip_existing, skip_missing, stats, explain, aovs;
@@ -42,6 +44,7 @@ static int parse_args(int argc, char** argv, tt_args* a)
 {
     memset(a, 0, sizeof *a);
     a->orbit.degrees = 360.0f;
+    a->fps = 24.0f;
     a->shard = a->shards = 1;
     for (int i = 2; i < argc; ++i) {
         const char* s = argv[i];
@@ -60,6 +63,11 @@ static int parse_args(int argc, char** argv, tt_args* a)
         veil_error err = {0};
         if (!strcmp(s, "-o")) a->exr = v;
         else if (!strcmp(s, "--png")) a->png = v;
+        else if (!strcmp(s, "--movie")) a->movie = v;
+        else if (!strcmp(s, "--contact-sheet")) a->sheet = v;
+        else if (!strcmp(s, "--fps")) {
+            if (!veil_cli_parse_float(v, 0.1f, 1000.0f, &a->fps)) return veil_cli_usage_error("--fps: expected frames a second in 0.1..1000, got '%s'", v);
+        }
         else if (!strcmp(s, "--frames")) {
             if (!veil_cli_parse_int(v, 1, VEIL_MAX_FRAMES, &a->frames))
                 return veil_cli_usage_error("--frames: expected a number of frames in 1..10000000, got '%s'", v);
@@ -136,6 +144,41 @@ static int exists(const char* path)
 {
     struct stat st;
     return stat(path, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/* The contact sheet and the movie, from every frame of the range (rendered by this run or others). */
+static veil_result review(const tt_args* a, long count, veil_error* err)
+{
+    if (count > 100000) return veil_fail(err, VEIL_ERR_LIMIT, "a movie or sheet of %ld frames: at most 100000", count);
+    char** names = calloc((size_t)count, sizeof *names);
+    if (!names) return veil_fail(err, VEIL_ERR_OOM, "out of memory");
+    veil_result r = VEIL_OK;
+    long missing = 0, first_missing = 0;
+    for (long i = 0; i < count && r == VEIL_OK; ++i) {
+        char path[4096];
+        long frame = veil_frame_range_at(&a->range, i);
+        r = veil_frame_pattern_path(a->exr, frame, path, sizeof path, err);
+        if (r == VEIL_OK && !exists(path) && !missing++) first_missing = frame;
+        if (r == VEIL_OK && !(names[i] = malloc(strlen(path) + 1))) r = veil_fail(err, VEIL_ERR_OOM, "out of memory");
+        if (r == VEIL_OK) strcpy(names[i], path);
+    }
+    if (r == VEIL_OK && missing)
+        r = veil_fail(err, VEIL_ERR_IO, "%s: %ld of the range's %ld frames are not written yet (frame %ld first); the "
+                      "movie and the contact sheet need them all (render the other shards first, then rerun with "
+                      "--skip-existing)", a->exr, missing, count, first_missing);
+    double t0 = veil_now_ms();
+    if (r == VEIL_OK && a->sheet) r = veil_review_contact_sheet((const char* const*)names, (int)count, a->sheet, err);
+    if (r == VEIL_OK && a->sheet) printf("wrote the contact sheet %s in %.2f s\n", a->sheet, (veil_now_ms() - t0) * 1e-3);
+    t0 = veil_now_ms();
+    if (r == VEIL_OK && a->movie) r = veil_review_movie((const char* const*)names, (int)count, a->fps, a->movie, err);
+    if (r == VEIL_OK && a->movie) {
+        struct stat st;
+        printf("wrote the movie %s (%lld bytes, %ld frames at %g fps) in %.2f s\n", a->movie,
+               stat(a->movie, &st) == 0 ? (long long)st.st_size : -1LL, count, a->fps, (veil_now_ms() - t0) * 1e-3);
+    }
+    for (long i = 0; i < count; ++i) free(names[i]);
+    free(names);
+    return r;
 }
 
 int veil_cmd_turntable(int argc, char** argv)
@@ -264,6 +307,7 @@ int veil_cmd_turntable(int argc, char** argv)
             printf("write      %9.2f ms\n", veil_now_ms() - t_write);
         }
     }
+    if (r == VEIL_OK && (a.movie || a.sheet)) r = review(&a, count, &err);
     if (r == VEIL_OK) {
         char step[32] = "";
         if (a.range.step > 1) snprintf(step, sizeof step, "x%ld", a.range.step);

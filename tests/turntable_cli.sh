@@ -55,4 +55,26 @@ grep -q "1 frames rendered, 3 already there" "$tmp/skip.txt" || fail "skip run: 
 [ "$(stat -c %Y "$tmp/one/t.1001.exr")" = "$(date -d '2001-01-01' +%s)" ] || fail "--skip-existing rewrote a frame"
 cmp -s "$tmp/one/t.1005.exr" "$tmp/two/t.1005.exr" || fail "the re-rendered frame differs"
 ls "$tmp/one" | grep -q 'veil-staged' && fail "a staging file was left behind"
+# review outputs, from the frames on disk: a contact sheet (4 frames: 2 x 2 thumbnails of 48 x 36, 2 pixels
+# apart: 102 x 78), and a movie through ffmpeg -- or, without ffmpeg, the exact error and no movie file
+"$veil" turntable "$scene" -o "$tmp/one/t.####.exr" "${args[@]}" --skip-existing --contact-sheet "$tmp/sheet.png" \
+  > "$tmp/sheet.txt" || fail "contact sheet: $(cat "$tmp/sheet.txt")"
+size=$(od -An -tu1 -j16 -N8 "$tmp/sheet.png" | awk '{print (($1 * 256 + $2) * 256 + $3) * 256 + $4 "x" (($5 * 256 + $6) * 256 + $7) * 256 + $8}')
+[ "$size" = "102x78" ] || fail "contact sheet of $size, expected 102x78"
+"$veil" turntable "$scene" -o "$tmp/one/t.####.exr" "${args[@]}" --skip-existing --movie "$tmp/t.mp4" \
+  > "$tmp/movie.txt" 2> "$tmp/movie.err"; rc=$?
+if command -v ffmpeg > /dev/null; then
+  [ $rc -eq 0 ] && [ -s "$tmp/t.mp4" ] || fail "movie: exit $rc: $(cat "$tmp/movie.err")"
+  grep -q "wrote the movie .* 4 frames at 24 fps" "$tmp/movie.txt" || fail "$(cat "$tmp/movie.txt")"
+else
+  [ $rc -eq 1 ] && grep -q "needs the ffmpeg program (Debian package ffmpeg)" "$tmp/movie.err" || fail "no ffmpeg: exit $rc: $(cat "$tmp/movie.err")"
+  [ ! -e "$tmp/t.mp4" ] || fail "a movie file without ffmpeg"
+fi
+ls "$tmp" | grep -q 'veil-frames\|veil-staged' && fail "the movie's scratch files were left behind"
+# a shard alone cannot make the movie of the whole range
+rm "$tmp/two/t.1007.exr"
+"$veil" turntable "$scene" -o "$tmp/two/t.%04d.exr" "${args[@]}" --shard 1/2 --skip-existing --contact-sheet "$tmp/s2.png" \
+  > /dev/null 2> "$tmp/shard.err"
+[ $? -eq 1 ] && grep -q "1 of the range's 4 frames are not written yet (frame 1007 first)" "$tmp/shard.err" ||
+  fail "a sheet over missing frames: $(cat "$tmp/shard.err")"
 echo "PASS"
