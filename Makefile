@@ -5,6 +5,8 @@
 #   make data   generate the VDBs that data/scenes/vdb_smoke.json and pyro.json render
 #   make accuracy  time against error of the GPU path vs the CPU reference
 #                  (bench/accuracy --quick, under 2 minutes; FULL=1: the full sweep)
+#   make test-farm  a turntable on a one-node Slurm cluster started on this machine
+#               (installs slurm-wlm, munge and ffmpeg; tests/farm_test.sh; run as root)
 #   make peers  veil against OpenVDB's vdb_render, time against error on three VDBs
 #               (bench/peers.py: installs libopenvdb-tools and gnuplot; ~30 minutes the
 #               first time, the references then cached; PEERS_ARGS="--quick": minutes)
@@ -18,7 +20,7 @@
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
-.PHONY: all deps build demo test data clean accuracy test-sanitize fuzz peers
+.PHONY: all deps build demo test data clean accuracy test-sanitize fuzz peers test-farm
 FUZZ_SECONDS ?= 60
 
 all: build
@@ -41,7 +43,13 @@ demo:
 test:
 	@$(MAKE) --no-print-directory deps
 	@$(MAKE) --no-print-directory build
-	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE farm
+
+test-farm:
+	@$(MAKE) --no-print-directory deps
+	@bash scripts/install-bench-deps.sh slurm-wlm munge ffmpeg
+	@$(MAKE) --no-print-directory build
+	@cd $(BUILD) && ctest --output-on-failure -L farm
 
 data:
 	@$(MAKE) --no-print-directory deps
@@ -71,7 +79,7 @@ test-sanitize:
 	@cd build-sanitize && LD_PRELOAD=$(wildcard /usr/lib/$(shell gcc -print-multiarch)/dri/swrast_dri.so) \
 	  ASAN_OPTIONS=detect_leaks=1:verify_asan_link_order=0 \
 	  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
-	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j $(JOBS)
+	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j $(JOBS) -LE farm
 
 fuzz:
 	@$(MAKE) --no-print-directory deps

@@ -58,3 +58,9 @@ veil_test(test_diffusion SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_diffusion.c LA
 add_test(NAME cli_turntable
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/turntable_cli.sh $<TARGET_FILE:veil_cli> ${PROJECT_SOURCE_DIR}/data/scenes/rbf_fog.json)
 set_tests_properties(cli_turntable PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)
+# A turntable on a one-node Slurm started by the test (tests/farm_test.sh): label farm,
+# not part of make test; make test-farm installs slurm-wlm and munge and runs it.
+add_test(NAME farm_slurm_turntable
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/farm_test.sh $<TARGET_FILE:veil_cli> ${PROJECT_SOURCE_DIR}/data/scenes/rbf_fog.json
+          ${PROJECT_SOURCE_DIR})
+set_tests_properties(farm_slurm_turntable PROPERTIES LABELS farm SKIP_RETURN_CODE 77 TIMEOUT 600)
