@@ -100,3 +100,18 @@ for f in 1 2 3 4 5 6; do
 done
 [ -s "$tmp/sheet.png" ] || fail "the review job made no contact sheet"
 echo "PASS: 6 frames from 2 array tasks, the same bytes as one local run; the review job's contact sheet"
+
+# bench/farm: with FARM_BENCH_SCENE and FARM_BENCH_FRAMES, the time from submission to an empty queue
+# for 1 and 2 array tasks on this cluster (docs/performance.md)
+if [ -n "${FARM_BENCH_SCENE:-}" ]; then
+  for tasks in 1 2; do
+    rm -rf "$tmp/bench" && mkdir -p "$tmp/bench"
+    t0=$(date +%s.%N)
+    SHEET="" MOVIE="" VEIL="$veil" bash "$root/scripts/slurm-turntable.sh" "$FARM_BENCH_SCENE" "$tmp/bench/f.####.exr" \
+      "1-${FARM_BENCH_FRAMES:-36}" $tasks > /dev/null 2>&1 || fail "bench submit"
+    while [ -n "$(squeue -h 2> /dev/null)" ]; do sleep 0.2; done
+    t1=$(date +%s.%N)
+    n=$(ls "$tmp/bench" | grep -c '\.exr$')
+    awk -v a="$t0" -v b="$t1" -v t=$tasks -v n="$n" 'BEGIN { printf "farm bench: %d task(s): %d frames in %.2f s\n", t, n, b - a }'
+  done
+fi
