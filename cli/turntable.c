@@ -235,6 +235,8 @@ int veil_cmd_turntable(int argc, char** argv)
     veil_renderer* ren = NULL;
     veil_image_set im = {0};
     long done = 0, skipped = 0, missing = 0;
+    double stage_total[VEIL_STAGE_COUNT] = {0}, write_total = 0.0;
+    int stage_runs[VEIL_STAGE_COUNT] = {0};
     for (long i = a.shard - 1; i < count && r == VEIL_OK; i += a.shards) {
         long frame = veil_frame_range_at(&a.range, i);
         char exr[4096], png[4096];
@@ -299,6 +301,11 @@ int veil_cmd_turntable(int argc, char** argv)
         if (r == VEIL_OK) r = c;
         if (r != VEIL_OK) break;
         ++done;
+        for (int k = 0; k < VEIL_STAGE_COUNT; ++k) {
+            stage_total[k] += st.stage[k].ms;
+            stage_runs[k] += st.stage[k].status == VEIL_STAGE_RAN;
+        }
+        write_total += veil_now_ms() - t_write;
         if (a.stats) {
             printf("frame %ld\n", frame);
             for (int k = 0; k < VEIL_STAGE_COUNT; ++k)
@@ -306,6 +313,13 @@ int veil_cmd_turntable(int argc, char** argv)
                        veil_stage_status_name(st.stage[k].status), st.stage[k].why);
             printf("write      %9.2f ms\n", veil_now_ms() - t_write);
         }
+    }
+    if (r == VEIL_OK && a.stats && done > 1) { /* the whole run: what ran how often, and its time */
+        printf("total over %ld frames\n", done);
+        for (int k = 0; k < VEIL_STAGE_COUNT; ++k)
+            printf("%-10s %9.2f ms  (ran on %d of %ld frames)\n", veil_stage_name((veil_stage_id)k), stage_total[k],
+                   stage_runs[k], done);
+        printf("write      %9.2f ms\n", write_total);
     }
     if (r == VEIL_OK && (a.movie || a.sheet)) r = review(&a, count, &err);
     if (r == VEIL_OK) {

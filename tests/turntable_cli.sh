@@ -46,6 +46,12 @@ for attr in frame worldToCamera worldToNDC veil:sceneHash veil:settings software
 done
 cmp -s "$tmp/one/t.1001.exr" "$tmp/one/t.1003.exr" && fail "frames 1001 and 1003 are the same image"
 
+# --stats: each frame's stages, and the run's total: inject once, the march on every frame
+"$veil" turntable "$scene" -o "$tmp/st.####.exr" --frames 3 --width 24 --height 18 --stats > "$tmp/stats.txt" ||
+  fail "--stats: $(cat "$tmp/stats.txt")"
+grep -q "^total over 3 frames" "$tmp/stats.txt" && grep -q "^inject .*(ran on 1 of 3 frames)" "$tmp/stats.txt" &&
+  grep -q "^render .*(ran on 3 of 3 frames)" "$tmp/stats.txt" || fail "--stats totals: $(cat "$tmp/stats.txt")"
+
 # --skip-existing: remove one frame, rerun: only it is rendered, the others keep their bytes and times
 touch -d '2001-01-01' "$tmp/one/t.1001.exr"
 rm "$tmp/one/t.1005.exr"
