@@ -9,9 +9,13 @@
 #include "core/clock.h"
 #include "core/progress.h"
 
+static int g_mode; /* veil_cli_progress_mode */
+
+void veil_cli_progress_mode(int mode) { g_mode = mode; }
+
 static struct {
     int on;
-    char label[64];
+    char label[96];
     char what[96];
     double start_ms, drawn_ms;
 } g_line;
@@ -35,7 +39,8 @@ static void draw(void* user, const char* what, double done, double total)
 void veil_cli_progress_begin(const char* label)
 {
     const char* term = getenv("TERM");
-    if (!isatty(STDERR_FILENO) || (term && strcmp(term, "dumb") == 0)) return;
+    if (g_mode < 0) return;
+    if (g_mode == 0 && (!isatty(STDERR_FILENO) || (term && strcmp(term, "dumb") == 0))) return;
     snprintf(g_line.label, sizeof g_line.label, "%s", label ? label : "");
     g_line.what[0] = '\0';
     g_line.start_ms = veil_now_ms();

@@ -5,6 +5,11 @@
 #ifndef VEIL_CLI_PROGRESS_H
 #define VEIL_CLI_PROGRESS_H
 
+/* 0: on a terminal only (the default), 1: always (--progress: also into a
+ * pipe or a log, each redraw then a line of its own starting with \r),
+ * -1: never (--quiet). */
+void veil_cli_progress_mode(int mode);
+
 /* label: what the line is about ("frame 2/36"; NULL: nothing), copied. */
 void veil_cli_progress_begin(const char* label);
 void veil_cli_progress_end(void);

@@ -54,6 +54,8 @@ static int parse_args(int argc, char** argv, tt_args* a)
         if (!strcmp(s, "--aovs")) { a->aovs = 1; continue; }
         if (!strcmp(s, "--skip-existing")) { a->skip_existing = 1; continue; }
         if (!strcmp(s, "--skip-missing")) { a->skip_missing = 1; continue; }
+        if (!strcmp(s, "--quiet")) { veil_cli_progress_mode(-1); continue; }
+        if (!strcmp(s, "--progress")) { veil_cli_progress_mode(1); continue; }
         if (s[0] != '-' || !s[1]) {
             if (a->scene) return veil_cli_usage_error("unexpected argument '%s'", s);
             a->scene = s;
@@ -235,7 +237,7 @@ int veil_cmd_turntable(int argc, char** argv)
     veil_renderer* ren = NULL;
     veil_image_set im = {0};
     long done = 0, skipped = 0, missing = 0;
-    double stage_total[VEIL_STAGE_COUNT] = {0}, write_total = 0.0;
+    double stage_total[VEIL_STAGE_COUNT] = {0}, write_total = 0.0, t_render = 0.0;
     int stage_runs[VEIL_STAGE_COUNT] = {0};
     for (long i = a.shard - 1; i < count && r == VEIL_OK; i += a.shards) {
         long frame = veil_frame_range_at(&a.range, i);
@@ -262,13 +264,16 @@ int veil_cmd_turntable(int argc, char** argv)
             r = veil_gl_create(NULL, &gl, &err);
             if (r == VEIL_OK) r = veil_renderer_create(gl, &ren, &err);
             if (r != VEIL_OK) break;
+            t_render = veil_now_ms();
         }
         veil_camera cam = veil_orbit_camera(&scene.camera, &a.orbit, i, count);
         veil_render_opts opts = opts_of(&a, frame, &cam);
         veil_render_stats st = {0};
-        char label[96];
-        snprintf(label, sizeof label, "frame %ld (%ld of %ld)", frame, done + skipped + 1,
-                 (count - (a.shard - 1) + a.shards - 1) / a.shards);
+        char label[96], eta[40] = "";
+        long mine = (count - (a.shard - 1) + a.shards - 1) / a.shards, left = mine - done - skipped - missing;
+        if (done > 0) /* the frames rendered so far, at their mean pace */
+            snprintf(eta, sizeof eta, ", about %.0f s left", (veil_now_ms() - t_render) * 1e-3 / (double)done * (double)left);
+        snprintf(label, sizeof label, "frame %ld (%ld of %ld%s)", frame, done + skipped + missing + 1, mine, eta);
         veil_cli_progress_begin(label);
         r = veil_render_scene_images(ren, &scene, &opts, &im, &st, &err);
         veil_cli_progress_end();

@@ -52,6 +52,13 @@ cmp -s "$tmp/one/t.1001.exr" "$tmp/one/t.1003.exr" && fail "frames 1001 and 1003
 grep -q "^total over 3 frames" "$tmp/stats.txt" && grep -q "^inject .*(ran on 1 of 3 frames)" "$tmp/stats.txt" &&
   grep -q "^render .*(ran on 3 of 3 frames)" "$tmp/stats.txt" || fail "--stats totals: $(cat "$tmp/stats.txt")"
 
+# the status line: none in a pipe by default, one with --progress (frames, then the time left)
+"$veil" turntable "$scene" -o "$tmp/st.####.exr" --frames 3 --width 24 --height 18 2> "$tmp/plain.err" > /dev/null
+[ ! -s "$tmp/plain.err" ] || fail "a status line into a pipe: $(cat "$tmp/plain.err")"
+"$veil" turntable "$scene" -o "$tmp/st.####.exr" --frames 3 --width 24 --height 18 --progress 2> "$tmp/prog.err" > /dev/null
+grep -q "veil: frame 1 (1 of 3)" "$tmp/prog.err" && grep -q "veil: frame 3 (3 of 3, about [0-9]* s left)" "$tmp/prog.err" ||
+  fail "--progress: $(tr '\r' '\n' < "$tmp/prog.err")"
+
 # --skip-existing: remove one frame, rerun: only it is rendered, the others keep their bytes and times
 touch -d '2001-01-01' "$tmp/one/t.1001.exr"
 rm "$tmp/one/t.1005.exr"
