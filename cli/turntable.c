@@ -197,14 +197,24 @@ int veil_cmd_turntable(int argc, char** argv)
         veil_render_opts opts = opts_of(&a, a.range.first, NULL);
         char* text = NULL;
         long mine = (count - (a.shard - 1) + a.shards - 1) / a.shards; /* this shard's frames */
-        r = veil_plan_explain(&scene, &opts, mine > 0 ? mine : 1, &text, &err);
+        const int sequence = veil_scene_is_sequence(&scene);
+        /* a sequence's first frame stands for each of its frames: every one has its own files */
+        r = veil_plan_explain(&scene, &opts, sequence || mine < 1 ? 1 : mine, &text, &err);
         if (r == VEIL_OK) {
             printf("frames %ld-%ld step %ld: %ld frames, shard %d/%d renders %ld of them\n", a.range.first, a.range.last,
                    a.range.step, count, a.shard, a.shards, mine);
-            if (veil_scene_is_sequence(&scene))
-                printf("sequence: a source's file changes with the frame, so inject and propagate run on every frame "
-                       "(the plan below is the first frame's file, as if it stood still)\n");
+            if (sequence)
+                printf("sequence: a source's file changes with the frame, so every frame runs inject, propagate and "
+                       "render, as the first frame's plan below\n");
             fputs(text, stdout);
+        }
+        for (long i = a.shard - 1; sequence && r == VEIL_OK && i < count; i += a.shards) {
+            long frame = veil_frame_range_at(&a.range, i);
+            veil_error ferr = {0};
+            if (veil_scene_set_frame(&scene, frame, &ferr) == VEIL_OK)
+                printf("frame %ld: runs every stage\n", frame);
+            else
+                printf("frame %ld: %s (%s)\n", frame, ferr.msg, a.skip_missing ? "skipped: --skip-missing" : "an error");
         }
         free(text);
         veil_scene_free(&scene);

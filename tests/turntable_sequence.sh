@@ -25,6 +25,10 @@ scene() { # $1: the file entry, $2: extra source keys
 JSON
 }
 scene "seq/puff.%04d.vdb" ', "frame_offset": 10'
+# the plan says that every frame runs every stage, and which frame lacks its file (no GPU)
+"$veil" turntable "$tmp/scene.json" --explain --frames 4 > "$tmp/plan.txt" || fail "--explain: $(cat "$tmp/plan.txt")"
+grep -q "^frame 1: runs every stage" "$tmp/plan.txt" && grep -q "^frame 3: .*frame 3: cannot open .*puff.0013.vdb.*(an error)" "$tmp/plan.txt" ||
+  fail "the plan of a sequence: $(cat "$tmp/plan.txt")"
 # frame 3 needs puff.0013.vdb: an error naming the frame and the file, and frames 1-2 written
 "$veil" turntable "$tmp/scene.json" -o "$tmp/out/f.####.exr" --frames 4 --degrees 0 2> "$tmp/err.txt" > /dev/null
 rc=$?
