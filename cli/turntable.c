@@ -237,6 +237,9 @@ int veil_cmd_turntable(int argc, char** argv)
         r = veil_cli_check_output_folder(first_exr, &err);
     }
     if (r == VEIL_OK && a.png) r = veil_cli_check_output_folder(first_png, &err);
+    /* and the review outputs' folders, before hours of frames rather than after */
+    if (r == VEIL_OK && a.sheet) r = veil_cli_check_output_folder(a.sheet, &err);
+    if (r == VEIL_OK && a.movie) r = veil_cli_check_output_folder(a.movie, &err);
     if (r != VEIL_OK) {
         veil_scene_free(&scene);
         return veil_cli_fail(r, &err);
