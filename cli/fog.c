@@ -28,6 +28,7 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "frame_out.h"
 #include "progress.h"
 #include "frame/renderer.h"
 #include "gpu/gl_context.h"
@@ -164,18 +165,8 @@ int veil_cmd_fog(int argc, char** argv)
         veil_cli_progress_end();
         if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
     }
-    /* all or nothing: both staged, then renamed over the targets (cli/cli_util.h) */
-    veil_cli_outputs out = {0};
-    const char* stage = r == VEIL_OK ? veil_cli_stage(&out, a.exr, &err) : NULL;
-    if (r == VEIL_OK) r = stage ? veil_image_set_write_exr(&im, stage, a.aovs, &err) : VEIL_ERR_IO;
-    stage = r == VEIL_OK && a.png ? veil_cli_stage(&out, a.png, &err) : NULL;
-    if (r == VEIL_OK && a.png) r = stage ? veil_write_png(stage, im.width, im.height, im.rgba, 0.0f, &err) : VEIL_ERR_IO;
-    veil_result committed = veil_cli_commit(&out, r == VEIL_OK, &err);
-    if (r == VEIL_OK) r = committed;
-    if (r == VEIL_OK && a.stats)
-        for (int i = 0; i < VEIL_STAGE_COUNT; ++i)
-            printf("%-10s %9.2f ms  (%s: %s)\n", veil_stage_name((veil_stage_id)i), st.stage[i].ms,
-                   veil_stage_status_name(st.stage[i].status), st.stage[i].why);
+    if (r == VEIL_OK) r = veil_cli_write_frame(&im, a.exr, a.png, a.aovs, NULL, &err); /* all or nothing */
+    if (r == VEIL_OK && a.stats) veil_cli_print_stages(&st);
     if (r == VEIL_OK) printf("wrote %s%s%s (depth from channel %s, as %s)\n", a.exr, a.png ? " and " : "",
                              a.png ? a.png : "", channel, a.depth_is_distance ? "distance along the ray" : "Z");
     veil_image_set_free(&im);

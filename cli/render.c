@@ -8,6 +8,7 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "frame_out.h"
 #include "progress.h"
 #include "core/clock.h"
 #include "frame/plan.h"
@@ -80,17 +81,6 @@ static int parse_render_args(int argc, char** argv, render_args* a)
     return -1;
 }
 
-/* One line per stage report: name, wall time, what happened and why. */
-static void print_stats(const veil_render_stats* st, double write_ms)
-{
-    for (int i = 0; i < VEIL_STAGE_COUNT; ++i) {
-        const veil_stage_report* rep = &st->stage[i];
-        printf("%-10s %9.2f ms  (%s: %s)\n", veil_stage_name((veil_stage_id)i), rep->ms,
-               veil_stage_status_name(rep->status), rep->why);
-    }
-    printf("write      %9.2f ms\n", write_ms);
-}
-
 static int explain(const render_args* a)
 {
     veil_error err = {0};
@@ -152,19 +142,12 @@ int veil_cmd_render(int argc, char** argv)
         if (r == VEIL_OK) r = veil_frame_path(a.exr, f, a.frames > 0, exr, sizeof exr, &err);
         if (r == VEIL_OK && a.png) r = veil_frame_path(a.png, f, a.frames > 0, png, sizeof png, &err);
         double t_write = veil_now_ms();
-        /* all or nothing, per frame: both files staged, then renamed over the targets (an existing
-         * OUT.exr stays as it was when the PNG cannot be written) */
-        veil_cli_outputs out = {0};
-        const char* stage = r == VEIL_OK ? veil_cli_stage(&out, exr, &err) : NULL;
-        if (r == VEIL_OK) r = stage ? veil_image_set_write_exr(&im, stage, a.aovs, &err) : VEIL_ERR_IO;
-        stage = r == VEIL_OK && a.png ? veil_cli_stage(&out, png, &err) : NULL;
-        if (r == VEIL_OK && a.png) r = stage ? veil_write_png(stage, im.width, im.height, im.rgba, 0.0f, &err) : VEIL_ERR_IO;
-        veil_result c = veil_cli_commit(&out, r == VEIL_OK, &err);
-        if (r == VEIL_OK) r = c;
+        if (r == VEIL_OK) r = veil_cli_write_frame(&im, exr, a.png ? png : NULL, a.aovs, NULL, &err);
         if (r != VEIL_OK) break;
         if (a.stats) {
             if (frames > 1) printf("frame %ld\n", f);
-            print_stats(&st, veil_now_ms() - t_write);
+            veil_cli_print_stages(&st);
+            printf("write      %9.2f ms\n", veil_now_ms() - t_write);
         }
         if (frames == 1 || f == frames - 1)
             printf("wrote %s%s%s%s in %.2f s\n", frames > 1 ? "frames up to " : "", exr, a.png ? " and " : "",

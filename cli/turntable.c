@@ -9,6 +9,7 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "frame_out.h"
 #include "progress.h"
 #include "review.h"
 #include "core/clock.h"
@@ -116,6 +117,11 @@ static int parse_args(int argc, char** argv, tt_args* a)
     if (!a->have_range) a->range = (veil_frame_range){1, a->frames ? a->frames : 1, 1};
     if (a->exr && veil_frame_pattern_kind(a->exr) != 1)
         return veil_cli_usage_error("-o: '%s' needs the frame number once, as #### or %%04d", a->exr);
+    if (a->movie) { /* what veil_review_movie makes, known before any frame is rendered */
+        const char* dot = strrchr(a->movie, '.');
+        if (!dot || (strcmp(dot, ".mp4") && strcmp(dot, ".mov") && strcmp(dot, ".mkv") && strcmp(dot, ".gif")))
+            return veil_cli_usage_error("--movie: '%s': expected a .mp4, .mov, .mkv or .gif file", a->movie);
+    }
     if (a->png && veil_frame_pattern_kind(a->png) != 1)
         return veil_cli_usage_error("--png: '%s' needs the frame number once, as #### or %%04d", a->png);
     return -1;
@@ -310,13 +316,8 @@ int veil_cmd_turntable(int argc, char** argv)
                                      {"veil:settings", settings}};
         memcpy(meta.strings, strings, sizeof strings);
         meta.n_strings = 4;
-        veil_cli_outputs out = {0}; /* the frame's files all or nothing, renamed into place */
-        const char* stage = r == VEIL_OK ? veil_cli_stage(&out, exr, &err) : NULL;
-        if (r == VEIL_OK) r = stage ? veil_image_set_write_exr_meta(&im, stage, a.aovs, &meta, &err) : VEIL_ERR_IO;
-        stage = r == VEIL_OK && a.png ? veil_cli_stage(&out, png, &err) : NULL;
-        if (r == VEIL_OK && a.png) r = stage ? veil_write_png(stage, im.width, im.height, im.rgba, 0.0f, &err) : VEIL_ERR_IO;
-        veil_result c = veil_cli_commit(&out, r == VEIL_OK, &err);
-        if (r == VEIL_OK) r = c;
+        /* the frame's files all or nothing, renamed into place */
+        if (r == VEIL_OK) r = veil_cli_write_frame(&im, exr, a.png ? png : NULL, a.aovs, &meta, &err);
         if (r != VEIL_OK) break;
         ++done;
         for (int k = 0; k < VEIL_STAGE_COUNT; ++k) {
@@ -326,9 +327,7 @@ int veil_cmd_turntable(int argc, char** argv)
         write_total += veil_now_ms() - t_write;
         if (a.stats) {
             printf("frame %ld\n", frame);
-            for (int k = 0; k < VEIL_STAGE_COUNT; ++k)
-                printf("%-10s %9.2f ms  (%s: %s)\n", veil_stage_name((veil_stage_id)k), st.stage[k].ms,
-                       veil_stage_status_name(st.stage[k].status), st.stage[k].why);
+            veil_cli_print_stages(&st);
             printf("write      %9.2f ms\n", veil_now_ms() - t_write);
         }
     }

@@ -12,7 +12,7 @@ trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
 for bad in "--range 5-1" "--range 1-4x0" "--shard 3/2" "--shard 0/2" "--frames 0" "--frames 3 --range 1-3" \
-           "--elevation 90" "--axis 0,0,0"; do
+           "--elevation 90" "--axis 0,0,0" "--movie out.avi" "--fps 0"; do
   "$veil" turntable "$scene" -o "$tmp/f.####.exr" $bad 2> "$tmp/usage.err"; rc=$?
   [ $rc -eq 2 ] || fail "'$bad': exit $rc, expected 2"
 done
