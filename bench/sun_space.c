@@ -15,7 +15,7 @@
  * anywhere, not only at voxel centres), each grid read as the march reads
  * it, in double here: the semi-Lagrangian volume trilinearly; the
  * light-space grid bilinearly on the node plane towards the light plus the
- * density over the stretch back (medium_common.glsl). Same metrics as
+ * density over the stretch back (lit_medium.glsl). Same metrics as
  * bench/propagation.c: sigma_t = 4 / (box width * max density), rms of the
  * relative error of D where tau_ref >= 0.05, max |exp(-tau) - exp(-tau_ref)|.
  * Exit status: 0, 77 when no GL 4.5 context can be made, 1 on errors. */
@@ -58,7 +58,7 @@ static const config configs[] = {
 #define CONFIGS (int)(sizeof configs / sizeof configs[0])
 
 /* D at world x as the march reads a light-space grid (render/shaders/
- * medium_common.glsl), in double: the bilinear lookup on the node plane just
+ * lit_medium.glsl), in double: the bilinear lookup on the node plane just
  * towards the light, plus the density over the stretch back to x, midpoint
  * rule in pieces of at most a voxel. */
 static double lookup(const veil_grid* g, const float* rho, const veil_sun_space* s, const float* D, const double x[3],

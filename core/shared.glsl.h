@@ -107,11 +107,12 @@
 #define VEIL_IMAGE_AOV_V 6      /* image unit: rgba32f march AOV: volumetric multiple scattering rgb */
 #define VEIL_IMAGE_AOV_Q 7      /* image unit: rgba32f march AOV: single scattering's out-scattered rgb, its P */
 #define VEIL_UBO_MARCH 0        /* uniform block: veil_march_block */
+#define VEIL_UBO_MEDIUM 6       /* uniform block: veil_medium_block (the march and the volumetric stage) */
 #define VEIL_TEX_EV 0           /* texture unit: sampled EV */
 #define VEIL_TEX_OPV0 1         /* texture units 1..4: sampled OPVs */
 #define VEIL_TEX_OCC 5          /* texture unit: occupancy bricks (max density per brick) */
 #define VEIL_TEX_LIMIT 6        /* texture unit: r32f per-pixel distance where the ray ends (veil fog) */
-#define VEIL_TEX_DIFFUSION 7    /* texture unit: rgba32f multiply scattered fluence (render/diffusion.h) */
+#define VEIL_TEX_DIFFUSION 7    /* texture unit: rgba32f multiply scattered fluence (volumetric/volumetric.h) */
 #define VEIL_TEX_EMISSION 8     /* texture unit: rgba32f emission eps (W m^-3 sr^-1) on the EV's grid */
 /* Texture units 9..12: r32f optical depth of up to VEIL_MAX_SUNS suns in
  * their light-space grids (propagate/sun_space.h). Only over a dense EV,
@@ -136,34 +137,45 @@ VEIL_STRUCT_BEGIN(veil_gpu_fog)
     VEIL_V4(box_max);   /* xyz: m */
 VEIL_STRUCT_END(veil_gpu_fog)
 
-/* Everything the ray marcher (render/shaders/march.comp) reads besides its
- * textures, in one std140 uniform block at VEIL_UBO_MARCH. */
-VEIL_STRUCT_BEGIN(veil_march_block)
-    VEIL_V4(cam_pos);      /* xyz: camera position (m) */
-    VEIL_V4(cam_fwd);      /* xyz: unit view direction */
-    VEIL_V4(cam_right);    /* xyz: right, scaled by tan(fov/2) and the aspect */
-    VEIL_V4(cam_up);       /* xyz: up, scaled by tan(fov/2) */
+/* The medium and the lights as every pass that reads them sees them — the
+ * march (render/) and the volumetric stage (volumetric/) — with no camera
+ * in it: one std140 uniform block at VEIL_UBO_MEDIUM, filled by
+ * veil_lit_medium_fill() (propagate/lit_medium.h) and read through
+ * propagate/shaders/lit_medium.glsl. */
+VEIL_STRUCT_BEGIN(veil_medium_block)
     VEIL_V4(box_min);      /* xyz: the EV's medium, first voxel centre (m) */
     VEIL_V4(box_max);      /* xyz: last voxel centre (m) */
     VEIL_V4(tex_min);      /* xyz: texture coordinates are (x - tex_min) * tex_inv_size */
     VEIL_V4(tex_inv_size); /* xyz: m^-1 */
     VEIL_V4(sigma_t);      /* rgb: m^-1 per unit density */
     VEIL_V4(sigma_s);      /* rgb: m^-1 per unit density */
-    VEIL_V4(background);   /* rgb: radiance behind the medium */
-    VEIL_V4(march);        /* x: step (m), y: floor on |S - X|^2 (m^2), z: voxel (m), w: HG g */
-    VEIL_V4(limits);       /* x: no step starts at or beyond this distance (m; 3e38: no limit); y: 1 with emission */
-    VEIL_IV4(size);        /* x, y: image size (pixels); z: lights; w: fogs */
-    VEIL_UV4(flags);       /* x: has a volume, y: skip empty bricks, z: jitter seed, w: per-pixel end */
-    VEIL_V4(octave);       /* volumetric multiple scattering: x: a, y: b, z: c, w: octaves (0: off) */
-    VEIL_V4(diffusion);    /* xyz: the volumetric field's texture origin (m); w: 0, or VEIL_FIELD_* */
-    VEIL_V4(diffusion_inv); /* xyz: texture coordinates per m */
+    VEIL_V4(shape);        /* x: floor on |S - X|^2 (m^2), y: voxel (m), z: HG g, w: 1 with emission */
+    VEIL_IV4(counts);      /* x: lights, y: fogs, z: 1 with a volume (the EV), w: - */
     veil_gpu_light lights[VEIL_MAX_LIGHTS];
     veil_gpu_fog fogs[VEIL_MAX_FOGS];
     VEIL_IV4(sun_of[VEIL_MAX_LIGHTS / 4]); /* [l / 4][l % 4]: 1 + the light-space grid holding light l's
                                               optical depth; 0: its channel of the OPVs */
     VEIL_V4(sun_map[3 * VEIL_MAX_SUNS]);   /* 3k .. 3k+2: grid k's world -> texture rows (xyz . x + w) */
     VEIL_V4(sun_step[VEIL_MAX_SUNS]);      /* grid k: x: node spacing along the light (m), y: nodes along it,
-                                              z: density samples of the last stretch (render/shaders/medium_common.glsl) */
+                                              z: density samples of the last stretch (propagate/shaders/lit_medium.glsl) */
+VEIL_STRUCT_END(veil_medium_block)
+
+/* What the ray marcher (render/shaders/march.comp) reads besides the
+ * medium block and its textures: the camera, the frame and the march's
+ * own settings, one std140 uniform block at VEIL_UBO_MARCH. */
+VEIL_STRUCT_BEGIN(veil_march_block)
+    VEIL_V4(cam_pos);      /* xyz: camera position (m) */
+    VEIL_V4(cam_fwd);      /* xyz: unit view direction */
+    VEIL_V4(cam_right);    /* xyz: right, scaled by tan(fov/2) and the aspect */
+    VEIL_V4(cam_up);       /* xyz: up, scaled by tan(fov/2) */
+    VEIL_V4(background);   /* rgb: radiance behind the medium */
+    VEIL_V4(march);        /* x: step (m); yzw: - */
+    VEIL_V4(limits);       /* x: no step starts at or beyond this distance (m; 3e38: no limit) */
+    VEIL_IV4(size);        /* x, y: image size (pixels) */
+    VEIL_UV4(flags);       /* x: -, y: skip empty bricks, z: jitter seed, w: per-pixel end */
+    VEIL_V4(octave);       /* volumetric multiple scattering: x: a, y: b, z: c, w: octaves (0: off) */
+    VEIL_V4(diffusion);    /* xyz: the volumetric field's texture origin (m); w: its veil_field_kind */
+    VEIL_V4(diffusion_inv); /* xyz: texture coordinates per m */
 VEIL_STRUCT_END(veil_march_block)
 
 /* ---- the sparse extinction volume (volume/sparse.h) --------------------- */
@@ -267,15 +279,23 @@ VEIL_FN float veil_spread_level(float w, float c, float K)
 #define VEIL_LUM_G 0.7152
 #define VEIL_LUM_B 0.0722
 
-/* ---- the diffusion estimate (render/diffusion.h) ------------------------ */
+/* ---- the diffusion estimate (volumetric/volumetric.h) ------------------------ */
 
 #define VEIL_DIFFUSION_GROUP 4  /* 4^3 cells per work group */
 #define VEIL_IMAGE_DIFF_SRC 0   /* image unit: rgba32f source S (rgb), density (a) */
 #define VEIL_IMAGE_DIFF_PHI 1   /* image unit: rgba32f fluence phi (rgb) */
 #define VEIL_UBO_DIFFUSION 2
 #define VEIL_DIFFUSION_MAX_EXTENT 1e4 /* m: a fog box larger than this gets no grid; escape paths end here */
-#define VEIL_FIELD_FLUENCE 1.0  /* veil_march_block.diffusion.w: the field is a fluence (diffusion) */
-#define VEIL_FIELD_ESCAPE 2.0   /* ... it is the octaves' gate, the chance to scatter again */
+/* What a volumetric field holds (veil_march_block.diffusion.w, as a float):
+ * the fluence of the diffusion solve, or the octaves' gate, the chance that
+ * light scattered at a point scatters again (volumetric/volumetric.h). */
+#ifdef VEIL_GLSL
+#define VEIL_FIELD_NONE 0
+#define VEIL_FIELD_FLUENCE 1
+#define VEIL_FIELD_ESCAPE 2
+#else
+typedef enum veil_field_kind { VEIL_FIELD_NONE = 0, VEIL_FIELD_FLUENCE = 1, VEIL_FIELD_ESCAPE = 2 } veil_field_kind;
+#endif
 
 VEIL_STRUCT_BEGIN(veil_diffusion_block)
     VEIL_V4(origin);     /* xyz: the first cell's centre (m); w: cell edge h (m) */

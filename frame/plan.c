@@ -6,8 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../propagate/opv_set.h"
 #include "../volume/scene_volume.h"
+#include "stages.h"
 
 veil_result veil_frame_path(const char* path, long frame, int numbered, char* out, size_t n, veil_error* err)
 {
@@ -61,11 +61,33 @@ static const char* light_type_name(int type)
     return type == VEIL_LIGHT_POINT ? "point" : type == VEIL_LIGHT_DIRECTIONAL ? "directional" : "spot";
 }
 
-/* "frames 1-9" / "frame 1" for the frames after the first. */
+/* "frame 1" / "frames 1-9" for the frames after the first. */
 static void later_frames(text* t, long frames)
 {
     if (frames == 2) put(t, "frame 1");
     else put(t, "frames 1-%ld", frames - 1);
+}
+
+/* The lights the plan keeps and why each other is dropped. */
+static void explain_lights(text* t, const veil_frame_plan* p)
+{
+    const veil_scene* s = p->scene;
+    if (p->emission_possible && p->light_count < VEIL_MAX_LIGHTS) {
+        int room = VEIL_MAX_LIGHTS - p->light_count;
+        put(t, "emission   up to %d point lights made at inject from the emission (multiple_scattering.emission_lights; "
+            "their textures are not counted below)\n", s->multiple.emission_lights < room ? s->multiple.emission_lights : room);
+    }
+    int k = 0;
+    for (size_t l = 0; l < s->light_count; ++l) {
+        const veil_light* li = &s->lights[l];
+        int is_used = k < p->light_count && !memcmp(&p->lights[k], li, sizeof *li);
+        k += is_used;
+        const char* why = is_used ? "adds light"
+                          : !(li->color[0] > 0.0f || li->color[1] > 0.0f || li->color[2] > 0.0f) ? "dropped: zero colour"
+                          : (!p->grid && !p->fogs)                                                 ? "dropped: no medium"
+                                                                   : "dropped: its cone misses the volume";
+        put(t, "light %-3zu  %-11s %s\n", l, light_type_name(li->type), why);
+    }
 }
 
 veil_result veil_plan_explain(const veil_scene* s, const veil_render_opts* opts, long frames, char** out,
@@ -73,123 +95,51 @@ veil_result veil_plan_explain(const veil_scene* s, const veil_render_opts* opts,
 {
     *out = NULL;
     if (frames < 1) return veil_fail(err, VEIL_ERR_INVALID, "explain: %ld frames (at least 1)", frames);
-    veil_render_opts o = veil_render_opts_resolve(opts, s);
+    veil_frame f;
+    memset(&f, 0, sizeof f);
+    veil_frame_plan* p = &f.plan;
+    veil_frame_plan_begin(p, s, opts, 0); /* no device here: no memory budget */
     text t = {0};
     put(&t, "plan: %s, %ld frame%s of %dx%d%s\n", s->path ? s->path : "<scene>", frames, frames == 1 ? "" : "s",
-        o.width, o.height, frames > 1 ? ", camera orbiting the look-at point (scene/camera.h)" : "");
+        p->o.width, p->o.height, frames > 1 ? ", camera orbiting the look-at point (scene/camera.h)" : "");
+    /* the volume as the files' headers describe it (no density is read into a GPU) */
     veil_scene_volume v;
     memset(&v, 0, sizeof v);
-    veil_result r = VEIL_OK;
-    uint64_t ev_key = veil_scene_volume_key(s);
-    int needed = veil_scene_volume_needed(s);
-    if (needed) r = veil_scene_volume_open(s, &v, err);
+    veil_result r = p->volume_needed ? veil_scene_volume_open(s, &v, err) : VEIL_OK;
     if (r != VEIL_OK) {
         free(t.s);
         return r;
     }
-    const veil_grid* g = v.has_volume ? &v.grid : NULL;
-    int fogs = 0;
-    for (size_t i = 0; i < s->medium.source_count; ++i) fogs += s->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL;
+    p->grid = v.has_volume ? &v.grid : NULL;
+    p->sparse = v.sparse;
+    p->particles = v.particle_count;
+    p->vdb_voxels = v.vdb_voxels;
+    p->resolution = p->volume_needed ? v.resolution : NULL;
+    p->emission_possible = p->grid && v.emission_count > 0 && s->multiple.emission_lights > 0;
 
-    /* inject */
-    if (!g) {
-        put(&t, "inject     skipped on every frame: %s%s\n",
-            needed ? "the sources hold no density" : "no voxelised source",
-            fogs ? " (analytic fog: closed form, never voxelised)" : "");
-    } else {
-        put(&t, "inject     frame 0: runs, key %016llx: %zu particles, %zu VDB voxels -> grid %dx%dx%d, voxel %.4g m\n",
-            (unsigned long long)ev_key, v.particle_count, v.vdb_voxels, g->dims[0], g->dims[1], g->dims[2], g->voxel);
-        put(&t, "           %s\n", v.resolution);
-        if (frames > 1) {
-            put(&t, "           ");
-            later_frames(&t, frames);
-            put(&t, ": cached (the key holds the sources' descriptions and files' identities, not the camera)\n");
+    /* the same table, the same keys and decisions as a render (frame/stages.h) */
+    char why[4096];
+    for (int i = 0; i < VEIL_STAGE_COUNT; ++i) {
+        const veil_stage_row* row = &veil_stage_table[i];
+        const char* name = veil_stage_name(row->id);
+        veil_stage_report rep = {.key = row->key(p)};
+        rep.status = row->decide(p, 0, why, sizeof why);
+        if (rep.status == VEIL_STAGE_SKIPPED)
+            put(&t, "%-10s skipped on every frame: %s\n", name, why);
+        else if (row->per_view)
+            put(&t, "%-10s every frame: runs, %s\n", name, why);
+        else {
+            put(&t, "%-10s frame 0: runs, %s\n", name, why);
+            if (frames > 1) {
+                row->decide(p, 1, why, sizeof why); /* what the next frames find kept */
+                put(&t, "           ");
+                later_frames(&t, frames);
+                put(&t, ": cached (%s; the key holds no camera)\n", why);
+            }
         }
+        if (row->settle) row->settle(&f, &rep);
+        if (row->id == VEIL_STAGE_INJECT) explain_lights(&t, p);
     }
-
-    /* lights, then propagate */
-    veil_light used[VEIL_MAX_LIGHTS];
-    int n = veil_render_lights(s, g, used);
-    if (g && v.emission_count > 0 && s->multiple.emission_lights > 0 && n < VEIL_MAX_LIGHTS)
-        put(&t, "emission   up to %d point lights made at inject from the emission (multiple_scattering.emission_lights; "
-            "their textures are not counted below)\n", s->multiple.emission_lights < VEIL_MAX_LIGHTS - n
-                                                          ? s->multiple.emission_lights : VEIL_MAX_LIGHTS - n);
-    int k = 0;
-    for (size_t l = 0; l < s->light_count; ++l) {
-        const veil_light* li = &s->lights[l];
-        int is_used = k < n && !memcmp(&used[k], li, sizeof *li);
-        k += is_used;
-        const char* why = is_used ? "adds light"
-                          : !(li->color[0] > 0.0f || li->color[1] > 0.0f || li->color[2] > 0.0f) ? "dropped: zero colour"
-                          : (!g && !fogs)                                                         ? "dropped: no medium"
-                                                                   : "dropped: its cone misses the volume";
-        put(&t, "light %-3zu  %-11s %s\n", l, light_type_name(li->type), why);
-    }
-    if (!g) {
-        put(&t, "propagate  skipped on every frame: no volume%s\n", fogs ? " (the fog's optical depth is closed form)" : "");
-    } else if (n == 0) {
-        put(&t, "propagate  skipped on every frame: no light reaches the medium\n");
-    } else {
-        veil_opv_params params = veil_render_opv_params(s, &o, NULL, 0); /* no device here: no memory budget */
-        veil_opv_light ol[VEIL_MAX_LIGHTS];
-        veil_opv_sun suns[VEIL_MAX_SUNS];
-        uint64_t sun_keys[VEIL_MAX_SUNS];
-        /* the GL's 3D textures reach at least VEIL_GL_MIN_3D_TEXTURE texels an axis (no GL here) */
-        int n_suns = veil_opv_plan_suns(g, ev_key, used, n, &params, v.sparse ? 0 : VEIL_GL_MIN_3D_TEXTURE, ol, suns,
-                                        sun_keys);
-        int textures = 0;
-        for (int tex = 0; 4 * tex < n; ++tex) {
-            int count = n - 4 * tex < 4 ? n - 4 * tex : 4, on_grid = 0;
-            for (int c = 0; c < count; ++c) on_grid += !ol[4 * tex + c].elsewhere;
-            textures += on_grid > 0;
-        }
-        put(&t, "propagate  frame 0: runs, %d light%s (%s), %d texture%s", n, n == 1 ? "" : "s",
-            v.sparse ? "sparse: brick by brick in the light's order" : veil_opv_method_name(o.method), textures,
-            textures == 1 ? "" : "s");
-        for (int tex = 0; 4 * tex < n; ++tex) {
-            int count = n - 4 * tex < 4 ? n - 4 * tex : 4, on_grid = 0;
-            for (int c = 0; c < count; ++c) on_grid += !ol[4 * tex + c].elsewhere;
-            if (on_grid)
-                put(&t, " key %016llx", (unsigned long long)veil_opv_texture_key(ev_key, &params, ol + 4 * tex, count));
-        }
-        for (int q = 0; q < n_suns; ++q) {
-            const float* a = suns[q].space.axis[0];
-            put(&t, "%s light %d in a light-space grid of %dx%dx%d nodes %.3g voxels apart across, key %016llx",
-                q ? "," : ";", suns[q].light, suns[q].space.nodes[0], suns[q].space.nodes[1], suns[q].space.nodes[2],
-                sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]), (unsigned long long)sun_keys[q]);
-        }
-        put(&t, "\n");
-        if (frames > 1) {
-            put(&t, "           ");
-            later_frames(&t, frames);
-            put(&t, ": cached (the keys hold the volume, the method and the lights' geometry, not the camera)\n");
-        }
-    }
-
-    /* render */
-    put(&t, "render     every frame: runs, %dx%d, quality %s, step %g voxels, %d light%s%s (depends on the camera)\n",
-        o.width, o.height, veil_quality_name(o.quality), o.step_voxels, n, n == 1 ? "" : "s",
-        fogs ? ", analytic fog in closed form" : "");
-    const veil_multiple* ms = &s->multiple;
-    if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_DIFFUSION)
-        put(&t, "           multiple scattering: the diffusion field (stage volumetric: once, %d cells along the "
-                "longest side; kept while the volume and lights are unchanged)\n", ms->diffusion_cells);
-    else if (ms->volumetric && ms->octaves > 1)
-        put(&t, "           multiple scattering: volumetric, %d octaves (a %g, b %g, c %g) in the march, gated by %s\n",
-            ms->octaves, ms->octave_a, ms->octave_b, ms->octave_c,
-            ms->octave_gate == VEIL_GATE_ESCAPE ? "the escape field (stage volumetric: once per volume, kept while "
-                                                  "the volume and medium are unchanged)"
-                                                : "the legs through each point");
-    /* the spread (frame/renderer.c): only the light from behind, or single scattering's when the
-     * volumetric estimate is off; whether the view is optically thin is known only after the march */
-    if (!ms->screen_space)
-        put(&t, "spread     skipped: off in the scene (multiple_scattering.screen_space)\n");
-    else if (ms->volumetric && !o.behind)
-        put(&t, "spread     skipped: nothing to spread (the volumetric estimate carries the medium's higher orders; "
-                "the background is a backdrop)\n");
-    else
-        put(&t, "spread     every frame: runs unless the view is optically thin (max P sigma_s < %g), "
-                "depends on the camera\n", ms->thin_threshold);
     veil_scene_volume_close(&v);
     if (t.oom) {
         free(t.s);

@@ -3,7 +3,8 @@
  * report. A stage runs when no result with its key is kept, is cached when
  * one is, and is skipped when the frame does not need it; the report says
  * which, why, and how long it took. `veil render --stats` prints the
- * reports of a frame, `--explain` the plan without rendering.
+ * reports of a frame, `--explain` the plan without rendering. The stages
+ * themselves are the rows of frame/stages.h's table, in this order.
  */
 #ifndef VEIL_STAGE_H
 #define VEIL_STAGE_H
@@ -13,7 +14,7 @@
 typedef enum veil_stage_id {
     VEIL_STAGE_INJECT = 0, /* sources -> extinction volume (volume/) */
     VEIL_STAGE_PROPAGATE,  /* EV -> optical-depth volumes (propagate/) */
-    VEIL_STAGE_VOLUMETRIC, /* EV (+ OPVs) -> a view-independent multiple-scattering field (render/diffusion.h) */
+    VEIL_STAGE_VOLUMETRIC, /* EV (+ OPVs) -> a view-independent multiple-scattering field (volumetric/volumetric.h) */
     VEIL_STAGE_RENDER,     /* the march: camera rays -> image set (render/) */
     VEIL_STAGE_SPREAD,     /* screen-space multiple scattering (render/spread.h) */
     VEIL_STAGE_COUNT

@@ -10,7 +10,7 @@
 #include "../scene/camera.h"
 
 struct veil_march {
-    GLuint program, program_emission, ubo; /* the march, and its variant with emission */
+    GLuint program, program_emission, ubo, medium_ubo; /* the march, and its variant with emission */
     GLuint program_sparse[2];              /* over a sparse volume (and with emission), made when first needed */
 };
 
@@ -25,6 +25,9 @@ veil_result veil_march_create(veil_march** out, veil_error* err)
                                      &m->program_emission, err);
     if (r == VEIL_OK)
         r = veil_gl_buffer(NULL, sizeof(veil_march_block), GL_DYNAMIC_STORAGE_BIT, "veil march block", &m->ubo, err);
+    if (r == VEIL_OK)
+        r = veil_gl_buffer(NULL, sizeof(veil_medium_block), GL_DYNAMIC_STORAGE_BIT, "veil march medium block",
+                           &m->medium_ubo, err);
     if (r != VEIL_OK) {
         veil_march_destroy(m);
         return r;
@@ -41,6 +44,7 @@ void veil_march_destroy(veil_march* m)
     glDeleteProgram(m->program_sparse[0]);
     glDeleteProgram(m->program_sparse[1]);
     glDeleteBuffers(1, &m->ubo);
+    glDeleteBuffers(1, &m->medium_ubo);
     free(m);
 }
 
@@ -49,97 +53,39 @@ static void set3(float dst[4], const float src[3], float w)
     dst[0] = src[0], dst[1] = src[1], dst[2] = src[2], dst[3] = w;
 }
 
-void veil_gpu_light_from(const veil_light* l, veil_gpu_light* out)
-{
-    set3(out->position, l->position, (float)l->type);
-    set3(out->direction, l->direction,
-         l->type == VEIL_LIGHT_POINT ? l->radius * l->radius : cosf(l->inner_angle_deg * (float)(VEIL_PI / 180.0)));
-    set3(out->color, l->color, cosf(l->outer_angle_deg * (float)(VEIL_PI / 180.0)));
-}
-
 veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u, veil_error* err)
 {
     veil_camera_basis cam;
     veil_result r = veil_camera_make_basis(d->camera, d->width, d->height, &cam, err);
     if (r != VEIL_OK) return r;
     memset(u, 0, sizeof *u);
-    const veil_medium* m = &d->scene->medium;
+    const veil_lit_medium* lm = &d->medium;
     set3(u->cam_pos, cam.pos, 0.0f);
     set3(u->cam_fwd, cam.fwd, 0.0f);
     set3(u->cam_right, cam.right, 0.0f);
     set3(u->cam_up, cam.up, 0.0f);
-    for (int c = 0; c < 3; ++c) u->sigma_t[c] = m->sigma_a[c] + m->sigma_s[c];
-    set3(u->sigma_s, m->sigma_s, 0.0f);
-    if (!d->no_background) set3(u->background, d->scene->background, 0.0f);
-    float g = m->phase.type == VEIL_PHASE_HG ? m->phase.g : 0.0f;
-    if (d->grid) {
-        float lo[3], hi[3], inv[3];
-        veil_grid_medium_box(d->grid, lo, hi);
-        for (int a = 0; a < 3; ++a) inv[a] = 1.0f / ((float)d->grid->dims[a] * d->grid->voxel);
-        set3(u->box_min, lo, 0.0f);
-        set3(u->box_max, hi, 0.0f);
-        set3(u->tex_min, d->grid->origin, 0.0f);
-        set3(u->tex_inv_size, inv, 0.0f);
-        float md = VEIL_MIN_LIGHT_DISTANCE_VOXELS * d->grid->voxel;
-        u->march[0] = d->step_voxels * d->grid->voxel;
-        u->march[1] = md * md;
-        u->march[2] = d->grid->voxel;
-    } else {
-        float md = VEIL_MIN_LIGHT_DISTANCE_VOXELS * VEIL_FOG_MIN_STEP;
-        u->march[0] = VEIL_FOG_MIN_STEP;
-        u->march[1] = md * md;
-    }
-    u->march[3] = g;
+    if (!d->no_background) set3(u->background, lm->scene->background, 0.0f);
+    u->march[0] = lm->grid ? d->step_voxels * lm->grid->voxel : VEIL_FOG_MIN_STEP;
     u->limits[0] = d->max_distance > 0.0f ? d->max_distance : 3.0e38f;
     int fogs = 0;
-    for (size_t i = 0; i < m->source_count && fogs < VEIL_MAX_FOGS; ++i) {
-        const veil_source* src = &m->sources[i];
-        if (src->type != VEIL_SOURCE_EXPONENTIAL) continue;
-        veil_gpu_fog* f = &u->fogs[fogs++];
-        set3(f->direction, src->fog.direction, src->fog.density);
-        set3(f->origin, src->fog.origin, src->fog.falloff);
-        set3(f->box_min, src->fog.bounds[0], 0.0f);
-        set3(f->box_max, src->fog.bounds[1], 0.0f);
-    }
-    int n = d->light_count < VEIL_MAX_LIGHTS ? d->light_count : VEIL_MAX_LIGHTS;
-    for (int l = 0; l < n; ++l) veil_gpu_light_from(&d->lights[l], &u->lights[l]);
-    u->size[0] = d->width, u->size[1] = d->height, u->size[2] = n, u->size[3] = fogs;
-    u->flags[0] = d->grid != NULL;
+    for (size_t i = 0; i < lm->scene->medium.source_count; ++i)
+        fogs += lm->scene->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL;
+    u->size[0] = d->width, u->size[1] = d->height;
     /* empty bricks hold no density but may glow: no skipping with emission (a sparse volume's bricks
      * not kept hold neither) */
-    u->flags[1] = d->grid != NULL && fogs == 0 && d->skip_empty && (!d->emission || d->sparse);
-    u->limits[1] = d->grid != NULL && d->emission ? 1.0f : 0.0f;
+    u->flags[1] = lm->grid != NULL && fogs == 0 && d->skip_empty && (!lm->emission || lm->sparse);
     u->flags[2] = d->seed;
     u->flags[3] = d->end_distance != NULL;
-    for (int k = 0; d->grid && !d->sparse && k < d->sun_count && k < VEIL_MAX_SUNS; ++k) {
-        int l = d->suns[k].light;
-        if (l < 0 || l >= n) continue;
-        u->sun_of[l / 4][l % 4] = k + 1;
-        for (int row = 0; row < 3; ++row) memcpy(u->sun_map[3 * k + row], d->suns[k].to_tex[row], sizeof u->sun_map[0]);
-        const float* c = d->suns[k].space.axis[2];
-        float along = sqrtf(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-        u->sun_step[k][0] = along * d->grid->voxel;
-        u->sun_step[k][1] = (float)d->suns[k].space.nodes[2];
-        u->sun_step[k][2] = ceilf(along); /* pieces of at most a voxel, as the prefix sum's panels */
-    }
-    const veil_multiple* ms = &d->scene->multiple;
-    if (d->diffusion && d->diffusion->texture) {
-        set3(u->diffusion, d->diffusion->tex_min, d->diffusion->kind);
-        set3(u->diffusion_inv, d->diffusion->tex_inv, 0.0f);
+    const veil_multiple* ms = &lm->scene->multiple;
+    if (d->field && d->field->texture) {
+        set3(u->diffusion, d->field->tex_min, (float)d->field->kind);
+        set3(u->diffusion_inv, d->field->tex_inv, 0.0f);
     }
     if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_OCTAVE && ms->octaves > 1) {
         u->octave[0] = ms->octave_a, u->octave[1] = ms->octave_b, u->octave[2] = ms->octave_c;
         u->octave[3] = (float)ms->octaves;
     }
     return VEIL_OK;
-}
-
-void veil_march_bind_depths(const veil_march_desc* d)
-{
-    for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, d && d->opv ? d->opv[t] : 0);
-    if (d && d->sparse) return; /* the sparse tables hold these units */
-    for (int k = 0; k < VEIL_MAX_SUNS; ++k)
-        glBindTextureUnit(VEIL_TEX_SUN0 + k, d && d->grid && k < d->sun_count ? d->suns[k].texture : 0);
 }
 
 static veil_result image(int w, int h, const char* label, GLuint* tex, veil_error* err)
@@ -157,15 +103,16 @@ void veil_march_set_dispatch_work(uint64_t work) { g_band_work = work ? work : V
 int veil_march_band_rows(const veil_march_desc* d, int w, int h)
 {
     double steps = 1.0;
-    if (d->grid) {
+    const veil_lit_medium* lm = &d->medium;
+    if (lm->grid) {
         float lo[3], hi[3];
-        veil_grid_medium_box(d->grid, lo, hi);
+        veil_grid_medium_box(lm->grid, lo, hi);
         const double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
-        steps += sqrt(dx * dx + dy * dy + dz * dz) / ((double)d->step_voxels * d->grid->voxel);
+        steps += sqrt(dx * dx + dy * dy + dz * dz) / ((double)d->step_voxels * lm->grid->voxel);
     }
-    for (size_t i = 0; i < d->scene->medium.source_count; ++i)
-        if (d->scene->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL) steps += 64.0;
-    const double per_row = (double)w * steps * (1.0 + d->light_count);
+    for (size_t i = 0; i < lm->scene->medium.source_count; ++i)
+        if (lm->scene->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL) steps += 64.0;
+    const double per_row = (double)w * steps * (1.0 + lm->light_count);
     double rows = floor((double)g_band_work / per_row / VEIL_MARCH_GROUP) * VEIL_MARCH_GROUP;
     if (rows < VEIL_MARCH_GROUP) rows = VEIL_MARCH_GROUP;
     return rows >= h ? h : (int)rows;
@@ -177,6 +124,9 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
     veil_march_block u;
     veil_result r = veil_march_block_fill(d, &u, err);
     if (r != VEIL_OK) return r;
+    veil_medium_block mu;
+    const veil_lit_medium* lm = &d->medium;
+    veil_lit_medium_fill(lm, &mu);
     int w = d->width, h = d->height;
     size_t floats;
     if (!veil_mul_sizes((size_t)w, (size_t)h, 4, 1, &floats)) return veil_fail(err, VEIL_ERR_LIMIT, "image too large");
@@ -203,26 +153,28 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
     if (r == VEIL_OK) {
         out->width = w, out->height = h;
         glNamedBufferSubData(m->ubo, 0, sizeof u, &u);
-        int e = d->emission != 0;
-        if (d->grid && d->sparse && !m->program_sparse[e])
+        glNamedBufferSubData(m->medium_ubo, 0, sizeof mu, &mu);
+        int e = lm->emission != 0;
+        if (lm->grid && lm->sparse && !m->program_sparse[e])
             r = veil_gpu_program_variant("render/shaders/march.comp",
                                          e ? "#define VEIL_SPARSE 1\n#define VEIL_MARCH_EMISSION 1\n" : "#define VEIL_SPARSE 1\n",
                                          e ? "sparse, emission" : "sparse", &m->program_sparse[e], err);
     }
     if (r == VEIL_OK) {
-        glUseProgram(d->grid && d->sparse ? m->program_sparse[d->emission != 0]
-                     : d->grid && d->emission ? m->program_emission : m->program);
-        veil_ev_sparse_bind(d->grid ? d->sparse : NULL);
+        glUseProgram(lm->grid && lm->sparse ? m->program_sparse[lm->emission != 0]
+                     : lm->grid && lm->emission ? m->program_emission : m->program);
+        veil_ev_sparse_bind(lm->grid ? lm->sparse : NULL);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, m->ubo);
-        glBindTextureUnit(VEIL_TEX_EV, d->grid ? d->ev : 0);
-        glBindTextureUnit(VEIL_TEX_OCC, d->grid ? d->occupancy : 0);
-        veil_march_bind_depths(d);
+        glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MEDIUM, m->medium_ubo);
+        glBindTextureUnit(VEIL_TEX_EV, lm->grid ? lm->ev : 0);
+        glBindTextureUnit(VEIL_TEX_OCC, lm->grid ? lm->occupancy : 0);
+        veil_lit_medium_bind_depths(lm);
         glBindTextureUnit(VEIL_TEX_LIMIT, limit);
-        glBindTextureUnit(VEIL_TEX_DIFFUSION, d->diffusion ? d->diffusion->texture : 0);
-        glBindTextureUnit(VEIL_TEX_EMISSION, d->grid ? d->emission : 0);
+        glBindTextureUnit(VEIL_TEX_DIFFUSION, d->field ? d->field->texture : 0);
+        glBindTextureUnit(VEIL_TEX_EMISSION, lm->grid ? lm->emission : 0);
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], tex[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        const GLuint program = d->grid && d->sparse ? m->program_sparse[d->emission != 0]
-                               : d->grid && d->emission ? m->program_emission : m->program;
+        const GLuint program = lm->grid && lm->sparse ? m->program_sparse[lm->emission != 0]
+                               : lm->grid && lm->emission ? m->program_emission : m->program;
         const GLint first_row = glGetUniformLocation(program, "u_first_row");
         const int band = veil_march_band_rows(d, w, h);
         const int report = veil_progress_wanted();
@@ -240,9 +192,10 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         for (int t = 0; t <= VEIL_TEX_EMISSION; ++t) glBindTextureUnit((GLuint)t, 0);
-        if (!(d->grid && d->sparse)) veil_march_bind_depths(NULL);
+        if (!(lm->grid && lm->sparse)) veil_lit_medium_bind_depths(NULL);
         veil_ev_sparse_bind(NULL);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, 0);
+        glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MEDIUM, 0);
         glUseProgram(0);
         r = veil_gl_check("ray march (render/shaders/march.comp)", err);
         for (int i = 0; i < N && r == VEIL_OK; ++i)

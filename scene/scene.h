@@ -159,7 +159,7 @@ typedef int veil_spread_interp;
 
 typedef enum veil_volumetric_method {
     VEIL_VOLUMETRIC_OCTAVE = 0,   /* octaves in the march (render/shaders/march.comp) */
-    VEIL_VOLUMETRIC_DIFFUSION = 1 /* a diffusion solve on a coarse grid (render/diffusion.h) */
+    VEIL_VOLUMETRIC_DIFFUSION = 1 /* a diffusion solve on a coarse grid (volumetric/volumetric.h) */
 } veil_volumetric_method;
 
 typedef enum veil_octave_gate {

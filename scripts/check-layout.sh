@@ -2,9 +2,12 @@
 # The layout's rules (docs/architecture.md), checked on every #include "..."
 # of the library, the CLI and the examples:
 #   - arrows point down the pipeline: each folder includes only the folders
-#     listed for it below (so io/ only core/ and scene/; volume/ and
-#     propagate/ never render/; reference/ never propagate/, render/, gpu/
-#     or frame/; nothing but cli/ includes cli/);
+#     listed for it below (so io/ only core/ and scene/; volume/,
+#     propagate/ and volumetric/ never render/; volume/ and propagate/
+#     never volumetric/; reference/ never propagate/, volumetric/, render/,
+#     gpu/ or frame/; nothing but cli/ includes cli/);
+#   - shaders' `//@include PATH` lines (paths from the root) keep the same
+#     arrows as the C that dispatches them;
 #   - the folder graph that the includes draw has no cycle;
 #   - examples/ include only the public header <veil.h>;
 #   - every quoted include resolves to a file of the tree (or a generated
@@ -22,10 +25,11 @@ declare -A allowed=(
   [gpu]="gpu core include"
   [volume]="volume io gpu scene core include"
   [propagate]="propagate volume gpu scene core include"
-  [render]="render propagate volume io gpu scene core include"
-  [frame]="frame render propagate volume io gpu scene core include"
+  [volumetric]="volumetric propagate volume gpu scene core include"
+  [render]="render volumetric propagate volume io gpu scene core include"
+  [frame]="frame render volumetric propagate volume io gpu scene core include"
   [reference]="reference volume io scene core include"
-  [cli]="cli frame reference render propagate volume io gpu scene core include"
+  [cli]="cli frame reference render volumetric propagate volume io gpu scene core include"
 )
 # files made at build time, included by path
 generated="shaders/registry.c"
@@ -57,7 +61,8 @@ for dir in "${!allowed[@]}"; do
         *" $to "*) ;;
         *) complain "$file includes $target: $dir/ may include only ${allowed[$dir]}" ;;
       esac
-    done < <(sed -n 's/^[[:space:]]*#[[:space:]]*include[[:space:]]*"\([^"]*\)".*/\1/p' "$file")
+    done < <(sed -n -e 's/^[[:space:]]*#[[:space:]]*include[[:space:]]*"\([^"]*\)".*/\1/p' \
+                    -e 's#^[[:space:]]*//@include[[:space:]]*\([^[:space:]]*\).*#\1#p' "$file")
   done < <(find "$dir" -type f \( -name '*.c' -o -name '*.h' -o -name '*.cpp' -o -name '*.comp' -o -name '*.glsl' \))
 done
 

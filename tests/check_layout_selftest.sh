@@ -2,8 +2,9 @@
 # scripts/check-layout.sh must catch what it guards against: on small trees
 # made here, an upward include (volume/ -> render/), an io/ file reaching
 # into volume/, a library file including cli/, an include that resolves to
-# nothing, and an example using an internal header each fail it; a clean
-# tree passes.
+# nothing, an example using an internal header, volumetric/ reaching into
+# render/ and a shader's //@include going up the pipeline each fail it; a
+# clean tree passes.
 set -uo pipefail
 check=$1
 tmp=$(mktemp -d)
@@ -24,4 +25,7 @@ fresh; mk render/bad.c '#include "../cli/c.h"'; expect fail "render/ including c
 fresh; mk scene/bad.c '#include "nowhere.h"'; expect fail "an include that is no file"
 fresh; mk examples/x.c '#include "frame/renderer.h"'; expect fail "an example with an internal header"
 fresh; mk examples/x.c '#include <veil.h>'; expect pass "an example with <veil.h>"
-echo "7 passed, 0 failed"
+fresh; mk volumetric/bad.c '#include "../render/r.h"'; expect fail "volumetric/ including render/"
+fresh; mk volume/shaders/bad.comp '//@include render/r.h'; expect fail "a shader of volume/ pulling in render/ (//@include)"
+fresh; mk render/shaders/ok.comp '//@include volume/v.h'; expect pass "a shader of render/ pulling in volume/"
+echo "10 passed, 0 failed"

@@ -51,7 +51,7 @@ add_test(NAME fog_cli
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/fog_cli.sh $<TARGET_FILE:veil_cli> $<TARGET_FILE:make_fog_frames>
           $<TARGET_FILE:exr_stats>)
 set_tests_properties(fog_cli PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)
-# The volumetric fields (render/diffusion.h): the octaves' escape field
+# The volumetric fields (volumetric/volumetric.h): the octaves' escape field
 # against its closed form, the diffusion fluence's convergence.
 veil_test(test_diffusion SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_diffusion.c LABELS "gpu;accuracy")
 # veil turntable: ranges, shards (byte-identical to one run), --skip-existing, usage errors.

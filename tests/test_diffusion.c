@@ -1,4 +1,4 @@
-/* The view-independent fields of render/diffusion.h.
+/* The view-independent fields of volumetric/volumetric.h.
  * 1. The escape field (the octaves' gate) of a constant-density cube
  *    against its closed form: from a cell centre x the density integral
  *    along axis direction +-e_a to the box of the voxel centres is rho
@@ -19,9 +19,9 @@
 #include "check.h"
 #include "frame/renderer.h"
 #include "gpu/gl_util.h"
-#include "render/diffusion.h"
+#include "volumetric/volumetric.h"
 
-static void escape_cube(veil_diffusion* d)
+static void escape_cube(veil_volumetric* d)
 {
     veil_error err = {0};
     const int N = 16;
@@ -40,13 +40,14 @@ static void escape_cube(veil_diffusion* d)
     s.medium.sigma_a[0] = s.medium.sigma_a[1] = s.medium.sigma_a[2] = 0.25f;
     veil_multiple_defaults(&s.multiple);
     GLuint opv[VEIL_MAX_OPV_TEXTURES] = {0};
-    veil_march_desc md = {.scene = &s, .camera = &s.camera, .width = 8, .height = 8, .grid = &g, .ev = ev,
-                          .opv = opv, .step_voxels = 0.5f};
-    veil_diffusion_field f;
-    veil_diffusion_report rep;
-    CHECK(veil_diffusion_update(d, &md, 1, (float)VEIL_FIELD_ESCAPE, &f, &rep, &err) == VEIL_OK, "%s", err.msg);
+    veil_volumetric_desc vd = {.kind = VEIL_FIELD_ESCAPE,
+                               .medium = {.scene = &s, .grid = &g, .ev = ev, .opv = opv},
+                               .diffusion_cells = s.multiple.diffusion_cells};
+    veil_volumetric_field f;
+    veil_volumetric_report rep;
+    CHECK(veil_volumetric_update(d, &vd, 1, &f, &rep, &err) == VEIL_OK, "%s", err.msg);
     int dims[3];
-    float* P = veil_diffusion_readback(d, dims);
+    float* P = veil_volumetric_readback(d, dims);
     CHECK(P != NULL && f.texture != 0, "an escape field was made");
     float lo[3], hi[3];
     veil_grid_medium_box(&g, lo, hi);
@@ -85,7 +86,7 @@ static void escape_cube(veil_diffusion* d)
     glDeleteTextures(1, &ev);
 }
 
-static void fluence_converges(veil_diffusion* d)
+static void fluence_converges(veil_volumetric* d)
 {
     veil_error err = {0};
     veil_source fog = {.type = VEIL_SOURCE_EXPONENTIAL,
@@ -104,17 +105,17 @@ static void fluence_converges(veil_diffusion* d)
     s.multiple.volumetric_method = VEIL_VOLUMETRIC_DIFFUSION;
     s.multiple.diffusion_cells = 24;
     GLuint opv[VEIL_MAX_OPV_TEXTURES] = {0};
-    veil_march_desc md = {.scene = &s, .camera = &s.camera, .width = 8, .height = 8, .lights = &sun,
-                          .light_count = 1, .opv = opv, .step_voxels = 0.5f};
+    veil_volumetric_desc vd = {.kind = VEIL_FIELD_FLUENCE,
+                               .medium = {.scene = &s, .lights = &sun, .light_count = 1, .opv = opv},
+                               .diffusion_cells = s.multiple.diffusion_cells};
     float* phi[2] = {NULL, NULL};
     int dims[3] = {0, 0, 0};
     for (int run = 0; run < 2; ++run) {
-        s.multiple.diffusion_iterations = run == 0 ? 0 : 4 * 3 * 24;
-        veil_diffusion_field f;
-        veil_diffusion_report rep;
-        CHECK(veil_diffusion_update(d, &md, 100 + (uint64_t)run, (float)VEIL_FIELD_FLUENCE, &f, &rep, &err) == VEIL_OK,
-              "%s", err.msg);
-        phi[run] = veil_diffusion_readback(d, dims);
+        vd.diffusion_iterations = run == 0 ? 0 : 4 * 3 * 24;
+        veil_volumetric_field f;
+        veil_volumetric_report rep;
+        CHECK(veil_volumetric_update(d, &vd, 100 + (uint64_t)run, &f, &rep, &err) == VEIL_OK, "%s", err.msg);
+        phi[run] = veil_volumetric_readback(d, dims);
         CHECK(phi[run] != NULL, "a fluence field was made (run %d)", run);
         printf("fluence run %d: %dx%dx%d cells, %d sweeps\n", run, dims[0], dims[1], dims[2], rep.iterations);
     }
@@ -147,13 +148,13 @@ int main(void)
 {
     veil_gl* gl = check_gpu_or_skip();
     veil_error err = {0};
-    veil_diffusion* d = NULL;
-    CHECK(veil_diffusion_create(&d, &err) == VEIL_OK, "%s", err.msg);
+    veil_volumetric* d = NULL;
+    CHECK(veil_volumetric_create(&d, &err) == VEIL_OK, "%s", err.msg);
     if (d) {
         escape_cube(d);
         fluence_converges(d);
     }
-    veil_diffusion_destroy(d);
+    veil_volumetric_destroy(d);
     veil_gl_destroy(gl);
     return check_finish();
 }

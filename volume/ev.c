@@ -163,7 +163,6 @@ void veil_ev_destroy(veil_ev* ev)
     free(ev);
 }
 
-int veil_ev_present(const veil_ev* ev) { return ev->present; }
 const veil_grid* veil_ev_grid(const veil_ev* ev) { return ev->present ? &ev->grid : NULL; }
 GLuint veil_ev_texture(const veil_ev* ev) { return ev->tex; }
 GLuint veil_ev_emission(const veil_ev* ev) { return ev->present ? ev->emission : 0; }

@@ -62,8 +62,7 @@ void veil_ev_destroy(veil_ev* ev);                          /* accepts NULL */
 /* Drops the volume (an empty medium: no texture at all). */
 void veil_ev_clear(veil_ev* ev);
 
-/* 1 when the EV holds a volume; its grid and textures (0 when none). */
-int veil_ev_present(const veil_ev* ev);
+/* The volume's grid (NULL when the EV holds none) and textures (0 when none). */
 const veil_grid* veil_ev_grid(const veil_ev* ev);
 GLuint veil_ev_texture(const veil_ev* ev);
 GLuint veil_ev_occupancy(const veil_ev* ev);

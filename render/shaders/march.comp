@@ -31,7 +31,7 @@
 // J (exp(-sigma_a P) - exp(-sigma_t P)) with J the step's light before
 // attenuation and P the density integral from the camera to the step; its
 // alpha is the luminance-weighted mean of that P.
-// Emission (u.limits.y, in the variant compiled with VEIL_MARCH_EMISSION):
+// Emission (med.shape.w, in the variant compiled with VEIL_MARCH_EMISSION):
 // the EV's emission texture eps per step, integrated in closed form like
 // in-scattering, added to L (the medium's own light).
 // Over a sparse volume (VEIL_SPARSE, volume/sparse.h) the EV, the optical
@@ -52,9 +52,10 @@ layout(binding = VEIL_IMAGE_AOV_Q, rgba32f) writeonly uniform image2D u_aov_q; /
 layout(binding = VEIL_TEX_OCC) uniform sampler3D u_occ; // max density per VEIL_BRICK^3 brick (ring included)
 layout(binding = VEIL_TEX_LIMIT) uniform sampler2D u_limit; // u.flags.w: distance (m) where each pixel's ray ends
 layout(binding = VEIL_TEX_DIFFUSION) uniform sampler3D u_phi; // u.diffusion.w: multiply scattered fluence (W/m^2)
-layout(binding = VEIL_TEX_EMISSION) uniform sampler3D u_emission; // u.limits.y: emission eps (W m^-3 sr^-1)
+layout(binding = VEIL_TEX_EMISSION) uniform sampler3D u_emission; // med.shape.w: emission eps (W m^-3 sr^-1)
 uniform int u_first_row; // the first row of this dispatch's band
-//@include render/shaders/medium_common.glsl
+layout(std140, binding = VEIL_UBO_MARCH) uniform veil_march_ubo { veil_march_block u; };
+//@include propagate/shaders/lit_medium.glsl
 
 uint hash32(uint x)
 {
@@ -72,13 +73,13 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
     multi = vec3(0.0);
     int octaves = int(u.octave.w);
     // each further scattering keeps the single-scattering albedo of the light
-    vec3 albedo = u.sigma_s.rgb / max(u.sigma_t.rgb, vec3(1e-30));
+    vec3 albedo = med.sigma_s.rgb / max(med.sigma_t.rgb, vec3(1e-30));
     // light that scattered many times is attenuated as diffusion attenuates
     // it, sqrt(3 sigma_a sigma_tr) (sigma_tr = sigma_a + sigma_s (1 - g)):
     // an octave's reduced extinction a^i sigma_t never goes below that
-    vec3 sigma_a = max(u.sigma_t.rgb - u.sigma_s.rgb, 0.0);
-    vec3 floor_t = sqrt(3.0 * sigma_a * (sigma_a + u.sigma_s.rgb * (1.0 - u.march.w)));
-    bool use_escape = u.diffusion.w == VEIL_FIELD_ESCAPE;
+    vec3 sigma_a = max(med.sigma_t.rgb - med.sigma_s.rgb, 0.0);
+    vec3 floor_t = sqrt(3.0 * sigma_a * (sigma_a + med.sigma_s.rgb * (1.0 - med.shape.z)));
+    bool use_escape = u.diffusion.w == float(VEIL_FIELD_ESCAPE);
     float escape = 0.0;
     if (use_escape) {
 #ifdef VEIL_SPARSE
@@ -93,33 +94,33 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
         escape = texture(u_phi, (x - u.diffusion.xyz) * u.diffusion_inv.xyz).r;
 #endif
     }
-    for (int l = 0; l < u.size.z; ++l) {
+    for (int l = 0; l < med.counts.x; ++l) {
         vec3 travel, E;
         float len;
         if (!light_at(l, x, travel, E, len)) continue;
         float D = depth_to_light(l, x, travel, len);
         float cos_theta = clamp(dot(travel, -dir), -1.0, 1.0);
-        sum += E * exp(-u.sigma_t.rgb * D) * veil_phase_hg(cos_theta, u.march.w);
+        sum += E * exp(-med.sigma_t.rgb * D) * veil_phase_hg(cos_theta, med.shape.z);
         // the chance that light on the two legs through x (from the light,
         // to the camera) scattered again: no medium around x, no higher orders
         // (D + p_cam kept finite: 0 * inf would be NaN where sigma_s = 0)
         // or, with the escape field, the chance averaged over all directions
         // (without a field, e.g. a fog box too large for a grid, the legs serve)
         float gate = use_escape ? escape
-                   : 1.0 - exp(-dot(u.sigma_s.rgb, vec3(1.0 / 3.0)) * min(D + p_cam, INF));
+                   : 1.0 - exp(-dot(med.sigma_s.rgb, vec3(1.0 / 3.0)) * min(D + p_cam, INF));
         // the legs' gate counts once; the escape field's chance is paid per further scattering
-        float a = 1.0, g = u.march.w, per = use_escape ? gate : 1.0;
+        float a = 1.0, g = med.shape.z, per = use_escape ? gate : 1.0;
         vec3 b = vec3(use_escape ? 1.0 : gate);
         for (int i = 1; i < octaves; ++i) {
             a *= u.octave.x, g *= u.octave.z;
             b *= u.octave.y * per * albedo;
-            vec3 att = exp(-max(a * u.sigma_t.rgb, floor_t) * D);
+            vec3 att = exp(-max(a * med.sigma_t.rgb, floor_t) * D);
             multi += b * E * att * veil_phase_hg(cos_theta, g);
         }
     }
     // the diffusion estimate: the fluence of light scattered at least once,
     // scattered again, isotropically, towards the camera
-    if (u.diffusion.w == VEIL_FIELD_FLUENCE)
+    if (u.diffusion.w == float(VEIL_FIELD_FLUENCE))
         multi += texture(u_phi, (x - u.diffusion.xyz) * u.diffusion_inv.xyz).rgb * (1.0 / (4.0 * VEIL_PI));
     return sum;
 }
@@ -128,8 +129,8 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
 float nearest_light(vec3 x)
 {
     float d = INF;
-    for (int l = 0; l < u.size.z; ++l)
-        if (int(u.lights[l].position.w) != VEIL_LIGHT_DIRECTIONAL) d = min(d, distance(x, u.lights[l].position.xyz));
+    for (int l = 0; l < med.counts.x; ++l)
+        if (int(med.lights[l].position.w) != VEIL_LIGHT_DIRECTIONAL) d = min(d, distance(x, med.lights[l].position.xyz));
     return d;
 }
 
@@ -146,10 +147,10 @@ void main()
     float depth_sum = 0.0, depth_w = 0.0; // extinction-weighted distance
 
     // the span of the boxes the ray meets
-    vec2 ev = u.flags.x != 0u ? box_hit(u.cam_pos.xyz, dir, u.box_min.xyz, u.box_max.xyz, 0.0, INF) : vec2(INF, -INF);
+    vec2 ev = med.counts.z != 0 ? box_hit(u.cam_pos.xyz, dir, med.box_min.xyz, med.box_max.xyz, 0.0, INF) : vec2(INF, -INF);
     float t_begin = ev.x < ev.y ? ev.x : INF, t_end = ev.x < ev.y ? ev.y : -INF;
-    for (int f = 0; f < u.size.w; ++f) {
-        vec2 fs = box_hit(u.cam_pos.xyz, dir, u.fogs[f].box_min.xyz, u.fogs[f].box_max.xyz, 0.0, INF);
+    for (int f = 0; f < med.counts.y; ++f) {
+        vec2 fs = box_hit(u.cam_pos.xyz, dir, med.fogs[f].box_min.xyz, med.fogs[f].box_max.xyz, 0.0, INF);
         if (fs.x < fs.y) {
             t_begin = min(t_begin, fs.x);
             t_end = max(t_end, fs.y);
@@ -163,7 +164,7 @@ void main()
     bool first = true;
     while (t < t_end && t < u.limits.x) {
         vec3 x0 = u.cam_pos.xyz + dir * t;
-        bool in_ev = u.flags.x != 0u && t >= ev.x && t < ev.y;
+        bool in_ev = med.counts.z != 0 && t >= ev.x && t < ev.y;
         if (in_ev && u.flags.y != 0u) {
 #ifdef VEIL_SPARSE
             // a brick not kept, or a whole empty node: jump to where the ray leaves it
@@ -176,11 +177,11 @@ void main()
                 continue;
             }
 #else
-            ivec3 b = ivec3(floor(((x0 - u.tex_min.xyz) / u.march.z - 0.5) / float(VEIL_BRICK)));
+            ivec3 b = ivec3(floor(((x0 - med.tex_min.xyz) / med.shape.y - 0.5) / float(VEIL_BRICK)));
             b = clamp(b, ivec3(0), textureSize(u_occ, 0) - 1);
             if (texelFetch(u_occ, b, 0).r <= 0.0) {
-                vec3 lo = u.tex_min.xyz + (vec3(b * VEIL_BRICK) + 0.5) * u.march.z;
-                float exit_t = box_hit(u.cam_pos.xyz, dir, lo, lo + float(VEIL_BRICK) * u.march.z, t, INF).y;
+                vec3 lo = med.tex_min.xyz + (vec3(b * VEIL_BRICK) + 0.5) * med.shape.y;
+                float exit_t = box_hit(u.cam_pos.xyz, dir, lo, lo + float(VEIL_BRICK) * med.shape.y, t, INF).y;
                 // past the exit by a hair that float t can hold (t + 1e-4 step may round to t)
                 t = max(exit_t, t) + max(1e-4 * u.march.x, 2.4e-7 * abs(t));
                 continue;
@@ -192,13 +193,13 @@ void main()
         if (first) step *= jitter;
         first = false;
         float te = min(t + step, t_end);
-        if (!in_ev && u.flags.x != 0u && t < ev.x) te = min(te, ev.x); // do not step over the EV's entry
+        if (!in_ev && med.counts.z != 0 && t < ev.x) te = min(te, ev.x); // do not step over the EV's entry
         float dt = te - t;
         vec3 x = u.cam_pos.xyz + dir * (0.5 * (t + te));
         float rho_dt = in_ev ? ev_density(x) * dt : 0.0;
         rho_dt = min(rho_dt + fog_integral(u.cam_pos.xyz, dir, t, te), INF); // finite, as D in in_scattered
 #ifdef VEIL_MARCH_EMISSION /* a variant: llvmpipe runs a masked-off texture read anyway (10 % of the march) */
-        if (in_ev && u.limits.y != 0.0) {
+        if (in_ev && med.shape.w != 0.0) {
             // emission eps constant over the step, attenuated within it as in-scattering is:
             // T eps dt (1 - exp(-x)) / x per channel (dt where the step has no density)
 #ifdef VEIL_SPARSE
@@ -208,26 +209,26 @@ void main()
             uint slot = sp_slot(eb, region);
             vec3 eps = slot == 0u ? vec3(0.0) : texture(u_emission, sp_atlas_uvw(slot, eb, q)).rgb;
 #else
-            vec3 eps = texture(u_emission, (x - u.tex_min.xyz) * u.tex_inv_size.xyz).rgb;
+            vec3 eps = texture(u_emission, (x - med.tex_min.xyz) * med.tex_inv_size.xyz).rgb;
 #endif
-            vec3 opt = u.sigma_t.rgb * rho_dt;
+            vec3 opt = med.sigma_t.rgb * rho_dt;
             L += T * eps * dt * vec3(veil_step_integral(opt.r), veil_step_integral(opt.g), veil_step_integral(opt.b));
         }
 #endif
         if (rho_dt > 0.0) {
-            vec3 opt = u.sigma_t.rgb * rho_dt;
+            vec3 opt = med.sigma_t.rgb * rho_dt;
             vec3 frac = vec3(veil_step_integral(opt.r), veil_step_integral(opt.g), veil_step_integral(opt.b));
             // sigma_s (rho_dt frac) = sigma_s (1 - exp(-opt)) / sigma_t <= 1: in this order (precise:
             // not reassociated) nothing overflows; rho_dt * L_in first can (dense fog near a light),
             // and 0 * inf in a channel without scattering is NaN
-            precise vec3 j = u.sigma_s.rgb * (rho_dt * frac);
+            precise vec3 j = med.sigma_s.rgb * (rho_dt * frac);
             precise vec3 w = T * j;
             vec3 multi;
             float p_mid = min(P + 0.5 * rho_dt, INF); // finite, as D: a channel with sigma = 0 gets exp(0)
             vec3 single = in_scattered(x, dir, p_mid, multi);
             L += w * single;
             Lv += w * multi;
-            vec3 q = j * single * max(exp(-(u.sigma_t.rgb - u.sigma_s.rgb) * p_mid) - exp(-u.sigma_t.rgb * p_mid), 0.0);
+            vec3 q = j * single * max(exp(-(med.sigma_t.rgb - med.sigma_s.rgb) * p_mid) - exp(-med.sigma_t.rgb * p_mid), 0.0);
             float yq = dot(q, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B));
             Q += q;
             q_p += yq * p_mid;

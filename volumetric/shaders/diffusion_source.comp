@@ -7,15 +7,15 @@
 layout(local_size_x = VEIL_DIFFUSION_GROUP, local_size_y = VEIL_DIFFUSION_GROUP, local_size_z = VEIL_DIFFUSION_GROUP) in;
 layout(binding = VEIL_IMAGE_DIFF_SRC, rgba32f) writeonly uniform image3D u_src;
 layout(std140, binding = VEIL_UBO_DIFFUSION) uniform veil_diffusion_ubo { veil_diffusion_block dg; };
-//@include render/shaders/medium_common.glsl
+//@include propagate/shaders/lit_medium.glsl
 
 float fog_density(vec3 x)
 {
     float rho = 0.0;
-    for (int f = 0; f < u.size.w; ++f) {
-        if (any(lessThan(x, u.fogs[f].box_min.xyz)) || any(greaterThan(x, u.fogs[f].box_max.xyz))) continue;
-        float k = u.fogs[f].origin.w * dot(x - u.fogs[f].origin.xyz, u.fogs[f].direction.xyz);
-        rho += u.fogs[f].direction.w * exp(-max(k, -VEIL_FOG_MAX_EXPONENT));
+    for (int f = 0; f < med.counts.y; ++f) {
+        if (any(lessThan(x, med.fogs[f].box_min.xyz)) || any(greaterThan(x, med.fogs[f].box_max.xyz))) continue;
+        float k = med.fogs[f].origin.w * dot(x - med.fogs[f].origin.xyz, med.fogs[f].direction.xyz);
+        rho += med.fogs[f].direction.w * exp(-max(k, -VEIL_FOG_MAX_EXPONENT));
     }
     return rho;
 }
@@ -26,15 +26,15 @@ void main()
     if (any(greaterThanEqual(c, dg.dims.xyz))) return;
     vec3 x = dg.origin.xyz + vec3(c) * dg.origin.w;
     float rho = fog_density(x);
-    if (u.flags.x != 0u && all(greaterThanEqual(x, u.box_min.xyz)) && all(lessThanEqual(x, u.box_max.xyz)))
-        rho += texture(u_ev, (x - u.tex_min.xyz) * u.tex_inv_size.xyz).r;
+    if (med.counts.z != 0 && all(greaterThanEqual(x, med.box_min.xyz)) && all(lessThanEqual(x, med.box_max.xyz)))
+        rho += texture(u_ev, (x - med.tex_min.xyz) * med.tex_inv_size.xyz).r;
     vec3 S = vec3(0.0);
     if (rho > 0.0)
-        for (int l = 0; l < u.size.z; ++l) {
+        for (int l = 0; l < med.counts.x; ++l) {
             vec3 travel, E;
             float len;
             if (!light_at(l, x, travel, E, len)) continue;
-            S += E * exp(-u.sigma_t.rgb * depth_to_light(l, x, travel, len));
+            S += E * exp(-med.sigma_t.rgb * depth_to_light(l, x, travel, len));
         }
-    imageStore(u_src, c, vec4(u.sigma_s.rgb * rho * S, rho));
+    imageStore(u_src, c, vec4(med.sigma_s.rgb * rho * S, rho));
 }

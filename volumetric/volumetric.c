@@ -1,48 +1,49 @@
-#include "diffusion.h"
+#include "volumetric.h"
 
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/hash.h"
 #include "../gpu/gl_util.h"
 #include "../gpu/programs.h"
 
-struct veil_diffusion {
-    GLuint source_program, sor_program, escape_program, ubo, march_ubo;
+struct veil_volumetric {
+    GLuint source_program, sor_program, escape_program, ubo, medium_ubo;
     GLuint escape_sparse_program; /* escape.comp over a sparse volume, made when first needed */
     float cell;                   /* the kept field's cell (m), for the report */
     int sparse;                   /* ... and whether it is over a sparse volume */
     GLuint src, phi;    /* 3D textures of the kept field (0: none) */
     int dims[3];
-    veil_diffusion_field field;
+    veil_volumetric_field field;
     uint64_t key;
     int keyed;          /* a field (or "none") is kept under key */
 };
 
-veil_result veil_diffusion_create(veil_diffusion** out, veil_error* err)
+veil_result veil_volumetric_create(veil_volumetric** out, veil_error* err)
 {
     *out = NULL;
-    veil_diffusion* d = calloc(1, sizeof *d);
-    if (!d) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the diffusion pass");
-    veil_result r = veil_gpu_program("render/shaders/diffusion_source.comp", &d->source_program, err);
-    if (r == VEIL_OK) r = veil_gpu_program("render/shaders/diffusion_sor.comp", &d->sor_program, err);
-    if (r == VEIL_OK) r = veil_gpu_program("render/shaders/escape.comp", &d->escape_program, err);
+    veil_volumetric* d = calloc(1, sizeof *d);
+    if (!d) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the volumetric stage");
+    veil_result r = veil_gpu_program("volumetric/shaders/diffusion_source.comp", &d->source_program, err);
+    if (r == VEIL_OK) r = veil_gpu_program("volumetric/shaders/diffusion_sor.comp", &d->sor_program, err);
+    if (r == VEIL_OK) r = veil_gpu_program("volumetric/shaders/escape.comp", &d->escape_program, err);
     if (r == VEIL_OK)
         r = veil_gl_buffer(NULL, sizeof(veil_diffusion_block), GL_DYNAMIC_STORAGE_BIT, "veil diffusion block", &d->ubo,
                            err);
     if (r == VEIL_OK)
-        r = veil_gl_buffer(NULL, sizeof(veil_march_block), GL_DYNAMIC_STORAGE_BIT, "veil diffusion march block",
-                           &d->march_ubo, err);
+        r = veil_gl_buffer(NULL, sizeof(veil_medium_block), GL_DYNAMIC_STORAGE_BIT, "veil volumetric medium block",
+                           &d->medium_ubo, err);
     if (r != VEIL_OK) {
-        veil_diffusion_destroy(d);
+        veil_volumetric_destroy(d);
         return r;
     }
     *out = d;
     return VEIL_OK;
 }
 
-void veil_diffusion_clear(veil_diffusion* d)
+void veil_volumetric_clear(veil_volumetric* d)
 {
     if (!d) return;
     glDeleteTextures(1, &d->src);
@@ -53,23 +54,23 @@ void veil_diffusion_clear(veil_diffusion* d)
     d->keyed = 0;
 }
 
-void veil_diffusion_destroy(veil_diffusion* d)
+void veil_volumetric_destroy(veil_volumetric* d)
 {
     if (!d) return;
-    veil_diffusion_clear(d);
+    veil_volumetric_clear(d);
     glDeleteProgram(d->source_program);
     glDeleteProgram(d->sor_program);
     glDeleteProgram(d->escape_program);
     glDeleteProgram(d->escape_sparse_program);
     glDeleteBuffers(1, &d->ubo);
-    glDeleteBuffers(1, &d->march_ubo);
+    glDeleteBuffers(1, &d->medium_ubo);
     free(d);
 }
 
 /* The grid: over the EV's medium box, cells of two voxels (at most `cells`
  * along the longest side); without an EV over the first fog's box. 0 when
  * there is none. */
-static int grid_of(const veil_march_desc* md, int cells, float lo[3], float* h, int dims[3])
+static int grid_of(const veil_lit_medium* md, int cells, float lo[3], float* h, int dims[3])
 {
     float hi[3];
     if (md->grid) {
@@ -95,6 +96,23 @@ static int grid_of(const veil_march_desc* md, int cells, float lo[3], float* h, 
     return 1;
 }
 
+int veil_volumetric_grid(const veil_volumetric_desc* d, float lo[3], float* h, int dims[3])
+{
+    return grid_of(&d->medium, d->kind == VEIL_FIELD_ESCAPE ? VEIL_ESCAPE_CELLS : d->diffusion_cells, lo, h, dims);
+}
+
+int veil_volumetric_sweeps(const veil_volumetric_desc* d, const int dims[3])
+{
+    if (d->kind != VEIL_FIELD_FLUENCE) return 0;
+    int longest = dims[0] > dims[1] ? (dims[0] > dims[2] ? dims[0] : dims[2]) : (dims[1] > dims[2] ? dims[1] : dims[2]);
+    return d->diffusion_iterations > 0 ? d->diffusion_iterations : 3 * longest;
+}
+
+const veil_volumetric_field* veil_volumetric_field_of(const veil_volumetric* v)
+{
+    return &v->field;
+}
+
 /* An rgba32f field: zero everywhere and beyond its border (phi = 0 there). */
 static veil_result texture3d(const int dims[3], const char* label, GLuint* tex, veil_error* err)
 {
@@ -110,26 +128,26 @@ static veil_result texture3d(const int dims[3], const char* label, GLuint* tex, 
 }
 
 /* The escape field of a sparse volume: VEIL_SPARSE_ESCAPE^3 points a kept
- * brick, in an atlas laid out like the density's (render/shaders/escape.comp
+ * brick, in an atlas laid out like the density's (volumetric/shaders/escape.comp
  * with VEIL_SPARSE). */
-static veil_result escape_sparse(veil_diffusion* d, const veil_march_desc* md, int dims[3], veil_error* err)
+static veil_result escape_sparse(veil_volumetric* d, const veil_lit_medium* md, int dims[3], veil_error* err)
 {
     const veil_ev_sparse* sp = md->sparse;
     veil_result r = VEIL_OK;
     if (!d->escape_sparse_program)
-        r = veil_gpu_program_variant("render/shaders/escape.comp", "#define VEIL_SPARSE 1\n", "sparse",
+        r = veil_gpu_program_variant("volumetric/shaders/escape.comp", "#define VEIL_SPARSE 1\n", "sparse",
                                      &d->escape_sparse_program, err);
-    veil_march_block mu;
-    if (r == VEIL_OK) r = veil_march_block_fill(md, &mu, err);
+    veil_medium_block mu;
+    veil_lit_medium_fill(md, &mu);
     for (int a = 0; a < 3; ++a) dims[a] = VEIL_SPARSE_ESCAPE * sp->block.atlas[a];
     if (r == VEIL_OK) r = texture3d(dims, "veil escape field (sparse atlas)", &d->phi, err);
     if (r != VEIL_OK) return r;
     veil_diffusion_block u;
     memset(&u, 0, sizeof u);
     for (int a = 0; a < 3; ++a) u.dims[a] = dims[a];
-    glNamedBufferSubData(d->march_ubo, 0, sizeof mu, &mu);
+    glNamedBufferSubData(d->medium_ubo, 0, sizeof mu, &mu);
     glNamedBufferSubData(d->ubo, 0, sizeof u, &u);
-    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, d->march_ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MEDIUM, d->medium_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_DIFFUSION, d->ubo);
     glUseProgram(d->escape_sparse_program);
     veil_ev_sparse_bind(sp);
@@ -141,15 +159,17 @@ static veil_result escape_sparse(veil_diffusion* d, const veil_march_desc* md, i
     glBindImageTexture(VEIL_IMAGE_DIFF_PHI, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindTextureUnit(VEIL_TEX_EV, 0);
     veil_ev_sparse_bind(NULL);
-    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, 0);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MEDIUM, 0);
     glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_DIFFUSION, 0);
     glUseProgram(0);
-    return veil_gl_check("escape field over a sparse volume (render/shaders/escape.comp)", err);
+    return veil_gl_check("escape field over a sparse volume (volumetric/shaders/escape.comp)", err);
 }
 
-veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, uint64_t key, float kind,
-                                  veil_diffusion_field* field, veil_diffusion_report* rep, veil_error* err)
+veil_result veil_volumetric_update(veil_volumetric* d, const veil_volumetric_desc* vd, uint64_t key,
+                                   veil_volumetric_field* field, veil_volumetric_report* rep, veil_error* err)
 {
+    const veil_lit_medium* md = &vd->medium;
+    const veil_field_kind kind = vd->kind;
     memset(rep, 0, sizeof *rep);
     rep->key = key;
     if (d->keyed && d->key == key) {
@@ -161,12 +181,11 @@ veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, 
         rep->sparse = d->sparse;
         return VEIL_OK;
     }
-    veil_diffusion_clear(d);
+    veil_volumetric_clear(d);
     memset(field, 0, sizeof *field);
-    const veil_multiple* ms = &md->scene->multiple;
     float lo[3], h;
     int dims[3];
-    int escape = kind == (float)VEIL_FIELD_ESCAPE;
+    int escape = kind == VEIL_FIELD_ESCAPE;
     if (md->grid && md->sparse) {
         rep->sparse = 1;
         d->sparse = 1, d->cell = 0.0f;
@@ -177,7 +196,7 @@ veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, 
         }
         veil_result r = escape_sparse(d, md, dims, err);
         if (r != VEIL_OK) {
-            veil_diffusion_clear(d);
+            veil_volumetric_clear(d);
             return r;
         }
         memcpy(d->dims, dims, sizeof dims);
@@ -190,14 +209,13 @@ veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, 
         d->sparse = 1;
         return VEIL_OK;
     }
-    if (!grid_of(md, escape ? VEIL_ESCAPE_CELLS : ms->diffusion_cells, lo, &h, dims)) {
+    if (!veil_volumetric_grid(vd, lo, &h, dims)) {
         d->keyed = 1, d->key = key;
         rep->skipped = 1;
         return VEIL_OK;
     }
-    veil_march_block mu;
-    veil_result r = veil_march_block_fill(md, &mu, err);
-    if (r != VEIL_OK) return r;
+    veil_medium_block mu;
+    veil_lit_medium_fill(md, &mu);
     const veil_medium* m = &md->scene->medium;
     float g = m->phase.type == VEIL_PHASE_HG ? m->phase.g : 0.0f, extent = 0.0f;
     veil_diffusion_block u;
@@ -213,20 +231,19 @@ veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, 
     u.sigma_tr[3] = VEIL_DIFFUSION_VACUUM;
     (void)extent;
     u.relax[0] = VEIL_DIFFUSION_OMEGA;
-    r = texture3d(dims, "veil diffusion source", &d->src, err);
+    veil_result r = texture3d(dims, "veil diffusion source", &d->src, err);
     if (r == VEIL_OK) r = texture3d(dims, "veil diffusion fluence", &d->phi, err);
     if (r != VEIL_OK) {
-        veil_diffusion_clear(d);
+        veil_volumetric_clear(d);
         return r;
     }
-    int longest = dims[0] > dims[1] ? (dims[0] > dims[2] ? dims[0] : dims[2]) : (dims[1] > dims[2] ? dims[1] : dims[2]);
-    int sweeps = escape ? 0 : ms->diffusion_iterations > 0 ? ms->diffusion_iterations : 3 * longest;
-    glNamedBufferSubData(d->march_ubo, 0, sizeof mu, &mu);
+    int sweeps = veil_volumetric_sweeps(vd, dims);
+    glNamedBufferSubData(d->medium_ubo, 0, sizeof mu, &mu);
     glNamedBufferSubData(d->ubo, 0, sizeof u, &u);
-    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, d->march_ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MEDIUM, d->medium_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_DIFFUSION, d->ubo);
     glBindTextureUnit(VEIL_TEX_EV, md->grid ? md->ev : 0);
-    veil_march_bind_depths(md);
+    veil_lit_medium_bind_depths(md);
     if (escape) {
         glUseProgram(d->escape_program);
         glBindImageTexture(VEIL_IMAGE_DIFF_PHI, d->phi, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
@@ -254,13 +271,13 @@ veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, 
     glBindImageTexture(VEIL_IMAGE_DIFF_SRC, 0, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     glBindImageTexture(VEIL_IMAGE_DIFF_PHI, 0, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     for (int t = 0; t <= VEIL_TEX_OPV0 + VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit((GLuint)t, 0);
-    if (!md->sparse) veil_march_bind_depths(NULL);
-    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, 0);
+    if (!md->sparse) veil_lit_medium_bind_depths(NULL);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MEDIUM, 0);
     glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_DIFFUSION, 0);
     glUseProgram(0);
-    r = veil_gl_check("diffusion (render/shaders/diffusion_*.comp)", err);
+    r = veil_gl_check("diffusion (volumetric/shaders/diffusion_*.comp)", err);
     if (r != VEIL_OK) {
-        veil_diffusion_clear(d);
+        veil_volumetric_clear(d);
         return r;
     }
     memcpy(d->dims, dims, sizeof dims);
@@ -279,7 +296,7 @@ veil_result veil_diffusion_update(veil_diffusion* d, const veil_march_desc* md, 
     return VEIL_OK;
 }
 
-float* veil_diffusion_readback(const veil_diffusion* d, int dims[3])
+float* veil_volumetric_readback(const veil_volumetric* d, int dims[3])
 {
     if (!d->phi) return NULL;
     size_t n = (size_t)d->dims[0] * (size_t)d->dims[1] * (size_t)d->dims[2] * 4;
@@ -288,4 +305,22 @@ float* veil_diffusion_readback(const veil_diffusion* d, int dims[3])
     glGetTextureImage(d->phi, 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * sizeof *out), out);
     memcpy(dims, d->dims, 3 * sizeof *dims);
     return out;
+}
+
+uint64_t veil_volumetric_key(uint64_t ev_key, const veil_volumetric_desc* d)
+{
+    const veil_scene* s = d->medium.scene;
+    int escape = d->kind == VEIL_FIELD_ESCAPE;
+    uint64_t key = veil_hash_bytes(ev_key, &s->medium.sigma_a, sizeof s->medium.sigma_a);
+    key = veil_hash_bytes(key, &s->medium.sigma_s, sizeof s->medium.sigma_s);
+    key = veil_hash_bytes(key, &s->medium.phase, sizeof s->medium.phase);
+    if (!escape) /* the source is lit: the lights' geometry and colour */
+        key = veil_hash_bytes(key, d->medium.lights, (size_t)d->medium.light_count * sizeof *d->medium.lights);
+    key = veil_hash_bytes(key, &escape, sizeof escape);
+    key = veil_hash_bytes(key, &d->diffusion_cells, sizeof d->diffusion_cells);
+    key = veil_hash_bytes(key, &d->diffusion_iterations, sizeof d->diffusion_iterations);
+    for (size_t i = 0; i < s->medium.source_count; ++i)
+        if (s->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL)
+            key = veil_hash_bytes(key, &s->medium.sources[i].fog, sizeof s->medium.sources[i].fog);
+    return key;
 }

@@ -1,4 +1,4 @@
-// veil — the octave estimate's gate (render/diffusion.h, "escape" field):
+// veil — the octave estimate's gate (volumetric/volumetric.h, "escape" field):
 // per cell of a coarse grid over the medium, the chance that light
 // scattered there scatters again before it leaves the medium, averaged over
 // directions:
@@ -13,25 +13,25 @@
 layout(local_size_x = VEIL_DIFFUSION_GROUP, local_size_y = VEIL_DIFFUSION_GROUP, local_size_z = VEIL_DIFFUSION_GROUP) in;
 layout(binding = VEIL_IMAGE_DIFF_PHI, rgba32f) writeonly uniform image3D u_out;
 layout(std140, binding = VEIL_UBO_DIFFUSION) uniform veil_diffusion_ubo { veil_diffusion_block dg; };
-//@include render/shaders/medium_common.glsl
+//@include propagate/shaders/lit_medium.glsl
 #ifdef VEIL_SPARSE
 layout(binding = VEIL_TEX_SPARSE_COORDS) uniform isamplerBuffer u_sp_coords;
 #endif
 
 float ev_integral(vec3 x, vec3 d)
 {
-    if (u.flags.x == 0u) return 0.0;
+    if (med.counts.z == 0) return 0.0;
 #ifdef VEIL_SPARSE
     return sp_integral((x - sp.origin.xyz) / sp.origin.w, d, 0.0, INF, 1.0) * sp.origin.w; // a step a voxel, as below
 #else
-    vec2 s = box_hit(x, d, u.box_min.xyz, u.box_max.xyz, 0.0, INF);
+    vec2 s = box_hit(x, d, med.box_min.xyz, med.box_max.xyz, 0.0, INF);
     if (s.x >= s.y) return 0.0;
-    float step = u.march.z, sum = 0.0;
+    float step = med.shape.y, sum = 0.0;
     int n = int(ceil((s.y - s.x) / step));
     float dt = (s.y - s.x) / float(max(n, 1));
     for (int i = 0; i < n; ++i) {
         vec3 p = x + d * (s.x + (float(i) + 0.5) * dt);
-        sum += texture(u_ev, (p - u.tex_min.xyz) * u.tex_inv_size.xyz).r * dt;
+        sum += texture(u_ev, (p - med.tex_min.xyz) * med.tex_inv_size.xyz).r * dt;
     }
     return sum;
 #endif
@@ -51,7 +51,7 @@ void main()
 #else
     vec3 x = dg.origin.xyz + vec3(c) * dg.origin.w;
 #endif
-    float st = dot(u.sigma_t.rgb, vec3(1.0 / 3.0)), sum = 0.0;
+    float st = dot(med.sigma_t.rgb, vec3(1.0 / 3.0)), sum = 0.0;
     for (int k = 0; k < 14; ++k) {
         vec3 d = k < 6 ? vec3(k / 2 == 0 ? 1.0 : 0.0, k / 2 == 1 ? 1.0 : 0.0, k / 2 == 2 ? 1.0 : 0.0) * ((k & 1) == 0 ? 1.0 : -1.0)
                        : normalize(vec3((k & 1) == 0 ? 1.0 : -1.0, ((k - 6) & 2) == 0 ? 1.0 : -1.0, ((k - 6) & 4) == 0 ? 1.0 : -1.0));

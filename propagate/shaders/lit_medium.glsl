@@ -1,10 +1,11 @@
-// veil — the medium and the lights as the march and the diffusion source
-// pass see them (included with //@include): the march's uniform block, the
+// veil — the medium and its lights as every pass after propagation sees
+// them (the march, the volumetric stage; included with //@include): the
+// camera-free medium block (veil_medium_block, propagate/lit_medium.h), the
 // EV and the optical-depth volumes, fogs in closed form.
 // With VEIL_SPARSE the EV is an atlas of bricks (volume/sparse.h), read
 // through volume/shaders/sparse_common.glsl, and so are the optical depths.
 layout(binding = VEIL_TEX_OPV0) uniform sampler3D u_opv[VEIL_MAX_OPV_TEXTURES];
-layout(std140, binding = VEIL_UBO_MARCH) uniform veil_march_ubo { veil_march_block u; };
+layout(std140, binding = VEIL_UBO_MEDIUM) uniform veil_medium_ubo { veil_medium_block med; };
 //@include volume/shaders/box_hit.glsl
 #ifdef VEIL_SPARSE
 //@include volume/shaders/sparse_common.glsl
@@ -19,7 +20,7 @@ float ev_density(vec3 x)
 #ifdef VEIL_SPARSE
     return sp_density((x - sp.origin.xyz) / sp.origin.w);
 #else
-    return texture(u_ev, (x - u.tex_min.xyz) * u.tex_inv_size.xyz).r;
+    return texture(u_ev, (x - med.tex_min.xyz) * med.tex_inv_size.xyz).r;
 #endif
 }
 
@@ -28,13 +29,13 @@ float ev_density(vec3 x)
 float fog_integral(vec3 p, vec3 d, float t0, float t1)
 {
     float sum = 0.0;
-    for (int f = 0; f < u.size.w; ++f) {
-        vec2 s = box_hit(p, d, u.fogs[f].box_min.xyz, u.fogs[f].box_max.xyz, t0, t1);
+    for (int f = 0; f < med.counts.y; ++f) {
+        vec2 s = box_hit(p, d, med.fogs[f].box_min.xyz, med.fogs[f].box_max.xyz, t0, t1);
         if (s.x >= s.y) continue;
-        float b = u.fogs[f].origin.w;
-        float k0 = b * dot(p + d * s.x - u.fogs[f].origin.xyz, u.fogs[f].direction.xyz);
-        float k1 = b * dot(p + d * s.y - u.fogs[f].origin.xyz, u.fogs[f].direction.xyz);
-        sum += veil_exp_fog_integral(u.fogs[f].direction.w, k0, k1, s.y - s.x);
+        float b = med.fogs[f].origin.w;
+        float k0 = b * dot(p + d * s.x - med.fogs[f].origin.xyz, med.fogs[f].direction.xyz);
+        float k1 = b * dot(p + d * s.y - med.fogs[f].origin.xyz, med.fogs[f].direction.xyz);
+        sum += veil_exp_fog_integral(med.fogs[f].direction.w, k0, k1, s.y - s.x);
     }
     return sum;
 }
@@ -44,7 +45,7 @@ float fog_integral(vec3 p, vec3 d, float t0, float t1)
 // the point where that path enters the EV's box.
 float ev_depth(int l, vec3 x, vec3 to, float len)
 {
-    if (u.flags.x == 0u) return 0.0;
+    if (med.counts.z == 0) return 0.0;
 #ifdef VEIL_SPARSE
     // in a kept brick, the optical-depth atlas; elsewhere (fog around the
     // volume) the path to the light, marched through the bricks it meets
@@ -55,10 +56,10 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
     if (slot != 0u) return texture(u_opv[l / 4], sp_atlas_uvw(slot, b, q))[l % 4];
     return sp_integral(q, to, 0.0, min(len / sp.origin.w, INF), VEIL_SPARSE_OD_STEP) * sp.origin.w;
 #else
-    vec2 s = box_hit(x, to, u.box_min.xyz, u.box_max.xyz, 0.0, len);
+    vec2 s = box_hit(x, to, med.box_min.xyz, med.box_max.xyz, 0.0, len);
     if (s.x > s.y) return 0.0;
     vec3 y = x + to * s.x; // where the path enters the box; s.y - s.x of it lies inside
-    int k = u.sun_of[l / 4][l % 4] - 1;
+    int k = med.sun_of[l / 4][l % 4] - 1;
     if (k >= 0) { // a sun in its light-space grid (propagate/sun_space.h)
         // D on the node plane just towards the light (bilinear within the
         // plane, none between planes) plus the density over the stretch
@@ -66,21 +67,21 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
         // interpolating between planes over-darkened the lit faces, where D
         // rises from 0 within one node spacing (docs/performance.md)
         vec4 p = vec4(y, 1.0);
-        vec3 q = vec3(dot(u.sun_map[3 * k], p), dot(u.sun_map[3 * k + 1], p), dot(u.sun_map[3 * k + 2], p));
-        float c = q.z * u.sun_step[k].y - 0.5;
+        vec3 q = vec3(dot(med.sun_map[3 * k], p), dot(med.sun_map[3 * k + 1], p), dot(med.sun_map[3 * k + 2], p));
+        float c = q.z * med.sun_step[k].y - 0.5;
         float c0 = max(floor(c), 0.0);
-        float back = (c - c0) * u.sun_step[k].x; // m to the plane, towards the light
-        q.z = (c0 + 0.5) / u.sun_step[k].y;
+        float back = (c - c0) * med.sun_step[k].x; // m to the plane, towards the light
+        q.z = (c0 + 0.5) / med.sun_step[k].y;
         float D = texture(u_sun[k], q).r;
         // the stretch's part in the box (the medium ends at its faces: a piece across one would
         // count density beyond it)
         back = min(back, s.y - s.x);
-        int n = int(u.sun_step[k].z);
+        int n = int(med.sun_step[k].z);
         float piece = back / float(n);
         for (int i = 0; i < n && back > 0.0; ++i) D += ev_density(y + to * (piece * (float(i) + 0.5))) * piece;
         return D;
     }
-    return texture(u_opv[l / 4], (y - u.tex_min.xyz) * u.tex_inv_size.xyz)[l % 4];
+    return texture(u_opv[l / 4], (y - med.tex_min.xyz) * med.tex_inv_size.xyz)[l % 4];
 #endif
 }
 
@@ -89,18 +90,18 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
 // and the distance to it (INF for a sun). False when it adds nothing here.
 bool light_at(int l, vec3 x, out vec3 travel, out vec3 E, out float len)
 {
-    if (int(u.lights[l].position.w) != VEIL_LIGHT_DIRECTIONAL) {
-        vec3 to_light = u.lights[l].position.xyz - x;
+    if (int(med.lights[l].position.w) != VEIL_LIGHT_DIRECTIONAL) {
+        vec3 to_light = med.lights[l].position.xyz - x;
         float r2 = max(dot(to_light, to_light),
-                       int(u.lights[l].position.w) == VEIL_LIGHT_POINT ? max(u.march.y, u.lights[l].direction.w) : u.march.y);
+                       int(med.lights[l].position.w) == VEIL_LIGHT_POINT ? max(med.shape.x, med.lights[l].direction.w) : med.shape.x);
         len = sqrt(r2);
         travel = -to_light / len;
-        E = u.lights[l].color.rgb / r2;
-        if (int(u.lights[l].position.w) == VEIL_LIGHT_SPOT)
-            E *= veil_spot_falloff(dot(travel, u.lights[l].direction.xyz), u.lights[l].direction.w, u.lights[l].color.w);
+        E = med.lights[l].color.rgb / r2;
+        if (int(med.lights[l].position.w) == VEIL_LIGHT_SPOT)
+            E *= veil_spot_falloff(dot(travel, med.lights[l].direction.xyz), med.lights[l].direction.w, med.lights[l].color.w);
     } else {
-        travel = u.lights[l].direction.xyz;
-        E = u.lights[l].color.rgb;
+        travel = med.lights[l].direction.xyz;
+        E = med.lights[l].color.rgb;
         len = INF;
     }
     return max(E.r, max(E.g, E.b)) > 0.0;

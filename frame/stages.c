@@ -1,0 +1,609 @@
+#include "stages.h"
+
+#include <epoxy/gl.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/hash.h"
+#include "../gpu/gl_context.h"
+#include "../propagate/lit_medium.h"
+#include "../propagate/opv_set.h"
+#include "../render/march.h"
+#include "../render/spread.h"
+#include "../volume/ev.h"
+#include "../volume/scene_volume.h"
+
+/* ---- the plan ---------------------------------------------------------- */
+
+/* The ladder, chosen from bench/peers.py --knobs (docs/performance.md):
+ * each rung slower and more accurate than the one below it on the shared
+ * smoke, none dominated on the three scenes of bench/peers.py. */
+static const veil_quality_rung rungs[VEIL_QUALITY_COUNT] = {
+    [VEIL_QUALITY_DRAFT] = {1.0f, VEIL_OPV_LIGHT_SPACE, 1.0f, 4.0f},
+    [VEIL_QUALITY_DEFAULT] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.5f, 4.0f},
+    [VEIL_QUALITY_HIGH] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.35f, 4.0f},
+    [VEIL_QUALITY_MAX] = {0.25f, VEIL_OPV_LIGHT_SPACE, 0.25f, 4.0f},
+};
+
+const veil_quality_rung* veil_quality_rung_of(veil_quality q)
+{
+    return &rungs[q > VEIL_QUALITY_UNSET && q < VEIL_QUALITY_COUNT ? q : VEIL_QUALITY_DEFAULT];
+}
+
+veil_render_opts veil_render_opts_resolve(const veil_render_opts* opts, const veil_scene* s)
+{
+    veil_render_opts o = opts ? *opts : (veil_render_opts){0};
+    if (!o.camera) o.camera = &s->camera;
+    if (o.width <= 0) o.width = o.camera->width;
+    if (o.height <= 0) o.height = o.camera->height;
+    if (o.quality <= VEIL_QUALITY_UNSET || o.quality >= VEIL_QUALITY_COUNT)
+        o.quality = s->quality > VEIL_QUALITY_UNSET && s->quality < VEIL_QUALITY_COUNT ? s->quality : VEIL_QUALITY_DEFAULT;
+    const veil_quality_rung* q = veil_quality_rung_of(o.quality);
+    if (!(o.step_voxels > 0.0f)) o.step_voxels = q->step_voxels;
+    if (o.method == VEIL_OPV_DEFAULT) o.method = q->method;
+    o.method = veil_opv_method_resolve(o.method);
+    if (!(o.sun_across > 0.0f)) o.sun_across = q->sun_across;
+    if (!(o.sun_along > 0.0f)) o.sun_along = q->sun_along;
+    return o;
+}
+
+static int count_fogs(const veil_scene* s)
+{
+    int n = 0;
+    for (size_t i = 0; i < s->medium.source_count; ++i) n += s->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL;
+    return n;
+}
+
+static int light_reaches(const veil_light* l, const veil_grid* g)
+{
+    if (!(l->color[0] > 0.0f || l->color[1] > 0.0f || l->color[2] > 0.0f)) return 0;
+    if (!g || l->type != VEIL_LIGHT_SPOT || l->outer_angle_deg >= 90.0f) return 1;
+    double c[3], d2 = 0.0, r2 = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        double half = 0.5 * g->dims[a] * (double)g->voxel;
+        c[a] = g->origin[a] + half - l->position[a];
+        d2 += c[a] * c[a];
+        r2 += half * half;
+    }
+    if (d2 <= r2) return 1; /* the light is within the sphere */
+    double cos_axis = (c[0] * l->direction[0] + c[1] * l->direction[1] + c[2] * l->direction[2]) / sqrt(d2);
+    double angle = acos(fmax(-1.0, fmin(1.0, cos_axis)));
+    double spread = l->outer_angle_deg * (VEIL_PI / 180.0) + asin(sqrt(r2 / d2));
+    return angle <= spread;
+}
+
+int veil_render_lights(const veil_scene* s, const veil_grid* g, veil_light* out)
+{
+    int n = 0;
+    if (!g && count_fogs(s) == 0) return 0; /* no medium at all */
+    for (size_t l = 0; l < s->light_count && n < VEIL_MAX_LIGHTS; ++l)
+        if (light_reaches(&s->lights[l], g)) out[n++] = s->lights[l];
+    return n;
+}
+
+veil_opv_params veil_render_opv_params(const veil_scene* s, const veil_render_opts* o, const veil_grid* g,
+                                       unsigned long long budget)
+{
+    float st_max = 0.0f;
+    for (int c = 0; c < 3; ++c) st_max = fmaxf(st_max, s->medium.sigma_a[c] + s->medium.sigma_s[c]);
+    /* D changes of tol move tau by at most st_max * tol */
+    veil_opv_params p = {.method = veil_opv_method_resolve(o->method),
+                         .tolerance = st_max > 0.0f ? VEIL_OPV_TAU_TOLERANCE / st_max : INFINITY,
+                         .sun_across = o->sun_across, .sun_along = o->sun_along};
+    if (g && budget > 0) {
+        /* what the device's budget leaves the suns' grids beside the EV and the rgba32f optical depths
+         * veil_ev_check_budget counted (one per four lights, and one more) */
+        double voxels = (double)g->dims[0] * g->dims[1] * g->dims[2];
+        int n = (int)s->light_count < VEIL_MAX_LIGHTS ? (int)s->light_count : VEIL_MAX_LIGHTS;
+        double used = voxels * 4.0 + voxels * 16.0 * ((n + 3) / 4 + 1);
+        p.sun_bytes = (double)budget > used ? (double)budget - used : 1.0;
+    }
+    return p;
+}
+
+void veil_frame_plan_begin(veil_frame_plan* p, const veil_scene* s, const veil_render_opts* opts,
+                           unsigned long long budget)
+{
+    memset(p, 0, sizeof *p);
+    p->scene = s;
+    p->o = veil_render_opts_resolve(opts, s);
+    p->fogs = count_fogs(s);
+    p->budget = budget;
+    p->volume_needed = veil_scene_volume_needed(s);
+}
+
+/* What the volumetric stage is asked for: the octaves' escape field when they are gated by it, the
+ * diffusion fluence when that is the method, else nothing. */
+static veil_field_kind field_kind(const veil_multiple* m)
+{
+    int escape = m->volumetric_method == VEIL_VOLUMETRIC_OCTAVE && m->octave_gate == VEIL_GATE_ESCAPE;
+    if (!m->volumetric || (m->volumetric_method == VEIL_VOLUMETRIC_OCTAVE && !escape) || m->octaves < 2 * escape)
+        return VEIL_FIELD_NONE;
+    return escape ? VEIL_FIELD_ESCAPE : VEIL_FIELD_FLUENCE;
+}
+
+void veil_frame_plan_volume(veil_frame_plan* p, const veil_grid* g, int sparse, const veil_light* emission,
+                            int n_emission)
+{
+    p->grid = g;
+    p->sparse = g ? sparse : 0;
+    p->light_count = veil_render_lights(p->scene, g, p->lights);
+    /* the medium's emission as lights (volume/emission_lights.h): after the scene's, while there is room */
+    if (n_emission > VEIL_MAX_LIGHTS - p->light_count) n_emission = VEIL_MAX_LIGHTS - p->light_count;
+    for (int i = 0; i < n_emission; ++i) p->lights[p->light_count++] = emission[i];
+    p->emission_lights = n_emission > 0 ? n_emission : 0;
+    p->opv = veil_render_opv_params(p->scene, &p->o, g, p->budget);
+    const veil_multiple* m = &p->scene->multiple;
+    p->volumetric = (veil_volumetric_desc){
+        .kind = field_kind(m),
+        .medium = {.scene = p->scene, .lights = p->lights, .light_count = p->light_count, .grid = g,
+                   .sparse = NULL},
+        .diffusion_cells = m->diffusion_cells,
+        .diffusion_iterations = m->diffusion_iterations};
+}
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 3, 4)))
+#endif
+static void say(char* why, size_t n, const char* fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(why, n, fmt, ap);
+    va_end(ap);
+}
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+static void why(veil_stage_report* rep, const char* fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(rep->why, sizeof rep->why, fmt, ap);
+    va_end(ap);
+}
+
+/* The medium as the passes after propagation read it, with the textures the stages hold (the
+ * optical-depth textures are the caller's to add: their array must outlive the use). */
+static veil_lit_medium lit_medium(const veil_frame* f)
+{
+    const veil_frame_plan* p = &f->plan;
+    veil_lit_medium m = {.scene = p->scene, .lights = p->lights, .light_count = p->light_count, .grid = p->grid};
+    if (!f->parts) return m;
+    m.ev = veil_ev_texture(f->parts->ev);
+    m.occupancy = veil_ev_occupancy(f->parts->ev);
+    m.sparse = veil_ev_sparse_of(f->parts->ev);
+    m.emission = veil_ev_emission(f->parts->ev);
+    m.suns = veil_opv_set_suns(f->parts->opv, &m.sun_count);
+    return m;
+}
+
+/* The EV changed (or is gone): nothing made from it is valid any more. */
+static void forget_volume(veil_frame_parts* parts)
+{
+    veil_ev_clear(parts->ev);
+    veil_opv_set_clear(parts->opv);
+    veil_volumetric_clear(parts->volumetric);
+    for (int i = VEIL_STAGE_INJECT; i <= VEIL_STAGE_VOLUMETRIC; ++i) parts->has[i] = 0, parts->kept[i] = 0;
+    parts->particles = 0;
+    parts->opv_textures = 0;
+}
+
+/* ---- inject: sources -> extinction volume ----------------------------- */
+
+static uint64_t inject_key(const veil_frame_plan* p)
+{
+    if (p->given_grid) {
+        uint64_t key = veil_hash_bytes(VEIL_FNV_OFFSET, p->given_grid, sizeof *p->given_grid);
+        return veil_hash_bytes(key, p->given_density, veil_grid_voxels(p->given_grid) * sizeof(float));
+    }
+    return veil_scene_volume_key(p->scene);
+}
+
+static veil_stage_status inject_decide(const veil_frame_plan* p, int kept, char* w, size_t n)
+{
+    if (kept) {
+        say(w, n, "%s", p->given_grid ? "the same density on the same grid"
+                                      : "the sources' descriptions and files are unchanged");
+        return VEIL_STAGE_CACHED;
+    }
+    if (p->given_grid) {
+        const int* d = p->given_grid->dims;
+        say(w, n, "a density given on a %dx%dx%d grid", d[0], d[1], d[2]);
+        return VEIL_STAGE_RAN;
+    }
+    if (!p->volume_needed) {
+        say(w, n, "no voxelised source%s", p->fogs ? " (analytic fog only: closed form)" : "");
+        return VEIL_STAGE_SKIPPED;
+    }
+    if (p->resolution && !p->grid) { /* explaining: the files hold nothing */
+        say(w, n, "the sources hold no density (no particle, no active voxel)");
+        return VEIL_STAGE_SKIPPED;
+    }
+    if (p->grid && p->resolution) /* explaining: what the files hold */
+        say(w, n, "key %016llx: %zu particles, %zu VDB voxels -> grid %dx%dx%d, voxel %.4g m\n           %s",
+            (unsigned long long)inject_key(p), p->particles, p->vdb_voxels, p->grid->dims[0], p->grid->dims[1],
+            p->grid->dims[2], p->grid->voxel, p->resolution);
+    else
+        say(w, n, "the sources changed");
+    return VEIL_STAGE_RAN;
+}
+
+static veil_result inject_build(veil_frame* f, veil_stage_report* rep, veil_error* err)
+{
+    veil_frame_parts* r = f->parts;
+    const veil_frame_plan* p = &f->plan;
+    const int had = r->has[VEIL_STAGE_INJECT];
+    forget_volume(r);
+    if (p->given_grid) {
+        veil_result res = veil_ev_build_density(r->ev, p->given_grid, p->given_density, (int)p->scene->light_count,
+                                                p->budget, err);
+        if (res == VEIL_OK) r->has[VEIL_STAGE_INJECT] = 1, r->kept[VEIL_STAGE_INJECT] = rep->key;
+        return res;
+    }
+    veil_scene_volume v;
+    veil_result res = veil_scene_volume_open(p->scene, &v, err);
+    if (res != VEIL_OK) return res;
+    veil_ev_report er = {0};
+    res = veil_ev_build_scene(r->ev, &v, (int)p->scene->light_count, p->budget, &er, err);
+    if (res == VEIL_OK) {
+        r->has[VEIL_STAGE_INJECT] = 1, r->kept[VEIL_STAGE_INJECT] = rep->key;
+        r->particles = er.particles;
+        f->st->vdb_voxels = er.vdb_voxels;
+        if (!v.has_volume) {
+            rep->status = VEIL_STAGE_SKIPPED;
+            why(rep, "the sources hold no density (no particle, no active voxel)");
+        } else {
+            const veil_grid* g = &v.grid;
+            const veil_ev_sparse* sp = veil_ev_sparse_of(r->ev);
+            char mem[200];
+            if (sp)
+                snprintf(mem, sizeof mem, "; %zu bricks kept of %.0f (%.0fx%.0fx%.0f), %.1f MiB on the GPU (dense: %.0f MiB)",
+                         sp->slots, ceil(g->dims[0] / 8.0) * ceil(g->dims[1] / 8.0) * ceil(g->dims[2] / 8.0),
+                         ceil(g->dims[0] / 8.0), ceil(g->dims[1] / 8.0), ceil(g->dims[2] / 8.0),
+                         (double)er.bytes / 1048576.0, (double)g->dims[0] * g->dims[1] * g->dims[2] * 4 / 1048576.0);
+            else
+                snprintf(mem, sizeof mem, "; %.1f MiB on the GPU", (double)er.bytes / 1048576.0);
+            why(rep, "%s: %zu particles, %zu VDB voxels, grid %dx%dx%d, voxel %.4g m (%s%s)",
+                had ? "the sources changed" : "no volume kept", er.particles, er.vdb_voxels, g->dims[0], g->dims[1],
+                g->dims[2], g->voxel, v.resolution, mem);
+        }
+    }
+    veil_scene_volume_close(&v);
+    return res;
+}
+
+static void inject_settle(veil_frame* f, const veil_stage_report* rep)
+{
+    veil_frame_plan* p = &f->plan;
+    p->ev_key = rep->key; /* what the volume's results are keyed by */
+    if (!f->parts) { /* explaining: the grid is the files' */
+        veil_frame_plan_volume(p, p->grid, p->sparse, NULL, 0);
+        return;
+    }
+    veil_frame_parts* r = f->parts;
+    if (rep->status == VEIL_STAGE_SKIPPED && !(r->has[VEIL_STAGE_INJECT] && r->kept[VEIL_STAGE_INJECT] == rep->key)) {
+        forget_volume(r); /* decided: no voxelised source, an empty medium remembered as such */
+        r->has[VEIL_STAGE_INJECT] = 1, r->kept[VEIL_STAGE_INJECT] = rep->key;
+    }
+    const veil_grid* g = veil_ev_grid(r->ev);
+    int emitting = 0;
+    const veil_light* el = veil_ev_emission_lights(r->ev, &emitting);
+    veil_frame_plan_volume(p, g, veil_ev_sparse_of(r->ev) != NULL, el, emitting);
+    veil_render_stats* st = f->st;
+    st->inject_cached = rep->status == VEIL_STAGE_CACHED;
+    st->emission_lights = p->emission_lights;
+    st->fogs = p->fogs;
+    st->lights_used = p->light_count;
+    st->method = p->o.method;
+    st->has_volume = g != NULL;
+    if (g) st->grid = *g;
+    st->particles = r->particles;
+    st->width = p->o.width, st->height = p->o.height;
+}
+
+/* ---- propagate: optical depth per light ------------------------------- */
+
+static uint64_t propagate_key(const veil_frame_plan* p)
+{
+    if (!p->grid || p->light_count == 0) return 0;
+    veil_opv_params keyed = p->opv;
+    keyed.sun_bytes = 0.0; /* as the textures' keys: the allowance shows through the grids it makes */
+    uint64_t key = veil_hash_bytes(p->ev_key, &keyed, sizeof keyed);
+    for (int l = 0; l < p->light_count; ++l) {
+        veil_opv_light ol;
+        veil_opv_light_from_world(p->grid, &p->lights[l], &ol);
+        key = veil_hash_bytes(key, &ol, sizeof ol);
+    }
+    return key;
+}
+
+static const char* propagate_method(const veil_frame_plan* p)
+{
+    return p->sparse ? "sparse: brick by brick in the light's order" : veil_opv_method_name(p->o.method);
+}
+
+static veil_stage_status propagate_decide(const veil_frame_plan* p, int kept, char* w, size_t n)
+{
+    if (!p->grid) {
+        say(w, n, "no volume: nothing to propagate%s", p->fogs ? " (the fog's optical depth is closed form)" : "");
+        return VEIL_STAGE_SKIPPED;
+    }
+    if (p->light_count == 0) {
+        say(w, n, "no light reaches the medium (of %zu)", p->scene->light_count);
+        return VEIL_STAGE_SKIPPED;
+    }
+    if (kept) {
+        say(w, n, "%d lights, %s: the volume, method and lights' geometry are unchanged", p->light_count,
+            propagate_method(p));
+        return VEIL_STAGE_CACHED;
+    }
+    /* the textures and light-space grids it will make (the GL's 3D textures reach at least
+     * VEIL_GL_MIN_3D_TEXTURE texels an axis; a device may allow more) */
+    veil_opv_light ol[VEIL_MAX_LIGHTS];
+    veil_opv_sun suns[VEIL_MAX_SUNS];
+    uint64_t sun_keys[VEIL_MAX_SUNS];
+    int n_suns = veil_opv_plan_suns(p->grid, p->ev_key, p->lights, p->light_count, &p->opv,
+                                    p->sparse ? 0 : VEIL_GL_MIN_3D_TEXTURE, ol, suns, sun_keys);
+    int textures = 0;
+    for (int tex = 0; 4 * tex < p->light_count; ++tex) {
+        int count = p->light_count - 4 * tex < 4 ? p->light_count - 4 * tex : 4, on_grid = 0;
+        for (int c = 0; c < count; ++c) on_grid += !ol[4 * tex + c].elsewhere;
+        textures += on_grid > 0;
+    }
+    size_t len = 0;
+    len += (size_t)snprintf(w, n, "%d light%s (%s), %d texture%s", p->light_count, p->light_count == 1 ? "" : "s",
+                            propagate_method(p), textures, textures == 1 ? "" : "s");
+    for (int tex = 0; 4 * tex < p->light_count && len < n; ++tex) {
+        int count = p->light_count - 4 * tex < 4 ? p->light_count - 4 * tex : 4, on_grid = 0;
+        for (int c = 0; c < count; ++c) on_grid += !ol[4 * tex + c].elsewhere;
+        if (on_grid)
+            len += (size_t)snprintf(w + len, n - len, " key %016llx",
+                                    (unsigned long long)veil_opv_texture_key(p->ev_key, &p->opv, ol + 4 * tex, count));
+    }
+    for (int q = 0; q < n_suns && len < n; ++q) {
+        const float* a = suns[q].space.axis[0];
+        len += (size_t)snprintf(w + len, n - len, "%s light %d in a light-space grid of %dx%dx%d nodes %.3g voxels "
+                                "apart across, key %016llx", q ? "," : ";", suns[q].light, suns[q].space.nodes[0],
+                                suns[q].space.nodes[1], suns[q].space.nodes[2],
+                                sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]),
+                                (unsigned long long)sun_keys[q]);
+    }
+    return VEIL_STAGE_RAN;
+}
+
+static veil_result propagate_build(veil_frame* f, veil_stage_report* rep, veil_error* err)
+{
+    veil_frame_parts* r = f->parts;
+    const veil_frame_plan* p = &f->plan;
+    veil_render_stats* st = f->st;
+    veil_opv_report orep = {0};
+    const veil_ev_sparse* sp = veil_ev_sparse_of(r->ev);
+    veil_result res = veil_opv_set_update(r->opv, p->grid, veil_ev_texture(r->ev),
+                                          p->o.no_skip ? 0 : veil_ev_occupancy(r->ev), sp, p->ev_key, p->lights,
+                                          p->light_count, &p->opv, &orep, err);
+    if (res != VEIL_OK) return res;
+    r->has[VEIL_STAGE_PROPAGATE] = 1, r->kept[VEIL_STAGE_PROPAGATE] = rep->key;
+    r->opv_textures = orep.computed + orep.cached;
+    st->opv_computed = orep.computed;
+    st->opv_cached = orep.cached;
+    st->propagate_iterations = orep.iterations;
+    rep->status = orep.computed || orep.suns_computed ? VEIL_STAGE_RAN : VEIL_STAGE_CACHED;
+    char from[64] = "";
+    if (p->emission_lights) snprintf(from, sizeof from, " (+%d from the emission)", p->emission_lights);
+    char suns[128] = "";
+    if (orep.suns)
+        snprintf(suns, sizeof suns, "; %d sun%s in light-space grids (%d computed), %.3g voxels apart across",
+                 orep.suns, orep.suns > 1 ? "s" : "", orep.suns_computed, orep.sun_across);
+    if (rep->status == VEIL_STAGE_RAN)
+        why(rep, "%d of %zu lights%s, %s, %d passes; %d textures computed (volume or light moved), %d cached%s; "
+            "%.1f MiB", p->light_count - p->emission_lights, p->scene->light_count, from, propagate_method(p),
+            orep.iterations, orep.computed, orep.cached, suns, orep.mib);
+    else
+        why(rep, "%d lights, %s: the volume, method and lights' geometry are unchanged", p->light_count,
+            propagate_method(p));
+    return VEIL_OK;
+}
+
+static void propagate_settle(veil_frame* f, const veil_stage_report* rep)
+{
+    if (f->parts && rep->status == VEIL_STAGE_CACHED && f->st->opv_computed == 0 && f->st->opv_cached == 0)
+        f->st->opv_cached = f->parts->opv_textures; /* decided: every texture is the kept one */
+}
+
+/* ---- volumetric: multiply scattered light, view-independent ----------- */
+
+static uint64_t volumetric_key(const veil_frame_plan* p)
+{
+    if (p->volumetric.kind == VEIL_FIELD_NONE || p->light_count == 0) return 0;
+    return veil_volumetric_key(p->ev_key, &p->volumetric);
+}
+
+static veil_stage_status volumetric_decide(const veil_frame_plan* p, int kept, char* w, size_t n)
+{
+    const veil_multiple* m = &p->scene->multiple;
+    const veil_volumetric_desc* d = &p->volumetric;
+    const int escape = d->kind == VEIL_FIELD_ESCAPE;
+    if (d->kind == VEIL_FIELD_NONE) {
+        say(w, n, "%s", m->volumetric ? "the octaves need no field (their gate is the legs through each point)"
+                                      : "no volumetric estimate (multiple_scattering.volumetric)");
+        return VEIL_STAGE_SKIPPED;
+    }
+    if (p->light_count == 0) {
+        say(w, n, "no light reaches the medium");
+        return VEIL_STAGE_SKIPPED;
+    }
+    if (p->sparse && !escape) {
+        say(w, n, "the diffusion solve needs a dense grid; over a sparse volume there is no volumetric estimate "
+                  "(set multiple_scattering.volumetric_method to \"octave\")");
+        return VEIL_STAGE_SKIPPED;
+    }
+    veil_volumetric_desc dd = *d;
+    dd.medium.sparse = NULL;
+    float lo[3], cell;
+    int dims[3];
+    if (!(p->sparse ? p->grid != NULL : veil_volumetric_grid(&dd, lo, &cell, dims) != 0)) {
+        say(w, n, "no grid: no medium, or a fog box over %g m%s", VEIL_DIFFUSION_MAX_EXTENT,
+            escape ? " (the octaves fall back to the legs gate)" : "");
+        return VEIL_STAGE_SKIPPED;
+    }
+    if (kept) {
+        say(w, n, "the volume, lights and medium are unchanged");
+        return VEIL_STAGE_CACHED;
+    }
+    if (escape && p->sparse)
+        say(w, n, "the octaves' escape field, %d points a kept brick (every %.4g m): view- and light-independent, "
+            "kept", VEIL_SPARSE_ESCAPE * VEIL_SPARSE_ESCAPE * VEIL_SPARSE_ESCAPE,
+            (double)VEIL_BRICK / (VEIL_SPARSE_ESCAPE - 1) * p->grid->voxel);
+    else if (escape)
+        say(w, n, "the octaves' escape field, %dx%dx%d cells of %.4g m: view- and light-independent, kept", dims[0],
+            dims[1], dims[2], cell);
+    else
+        say(w, n, "%dx%dx%d cells of %.4g m, %d red-black sweeps: view-independent, kept for the next frames", dims[0],
+            dims[1], dims[2], cell, veil_volumetric_sweeps(&dd, dims));
+    return VEIL_STAGE_RAN;
+}
+
+static veil_result volumetric_build(veil_frame* f, veil_stage_report* rep, veil_error* err)
+{
+    veil_volumetric_desc d = f->plan.volumetric;
+    d.medium = lit_medium(f);
+    GLuint opv[VEIL_MAX_OPV_TEXTURES];
+    for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) opv[t] = veil_opv_set_texture(f->parts->opv, t);
+    d.medium.opv = opv;
+    veil_volumetric_report vr;
+    veil_result res = veil_volumetric_update(f->parts->volumetric, &d, rep->key, &f->field, &vr, err);
+    if (res != VEIL_OK) return res;
+    f->parts->has[VEIL_STAGE_VOLUMETRIC] = 1, f->parts->kept[VEIL_STAGE_VOLUMETRIC] = rep->key;
+    if (vr.skipped) { /* decide() found a grid; the module did not: say so rather than hide it */
+        rep->status = VEIL_STAGE_SKIPPED;
+        why(rep, "no grid was made for the field");
+    }
+    return VEIL_OK;
+}
+
+static void volumetric_settle(veil_frame* f, const veil_stage_report* rep)
+{
+    memset(&f->field, 0, sizeof f->field);
+    if (f->parts && rep->status != VEIL_STAGE_SKIPPED) f->field = *veil_volumetric_field_of(f->parts->volumetric);
+}
+
+/* ---- render: the march ------------------------------------------------ */
+
+static uint64_t per_view_key(const veil_frame_plan* p)
+{
+    (void)p;
+    return 0; /* depends on the camera: nothing is kept */
+}
+
+static veil_stage_status render_decide(const veil_frame_plan* p, int kept, char* w, size_t n)
+{
+    (void)kept;
+    const veil_multiple* ms = &p->scene->multiple;
+    char multiple[200] = "";
+    if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_DIFFUSION)
+        snprintf(multiple, sizeof multiple, ", multiple scattering from the diffusion field (stage volumetric)");
+    else if (ms->volumetric && ms->octaves > 1)
+        snprintf(multiple, sizeof multiple, ", volumetric multiple scattering: %d octaves (a %g, b %g, c %g) gated by %s",
+                 ms->octaves, ms->octave_a, ms->octave_b, ms->octave_c,
+                 ms->octave_gate == VEIL_GATE_ESCAPE ? "the escape field (stage volumetric)"
+                                                     : "the legs through each point");
+    say(w, n, "%dx%d, quality %s, step %g voxels, %d light%s%s%s: depends on the camera", p->o.width, p->o.height,
+        veil_quality_name(p->o.quality), p->o.step_voxels, p->light_count, p->light_count == 1 ? "" : "s",
+        p->fogs ? ", analytic fog in closed form" : "", multiple);
+    return VEIL_STAGE_RAN;
+}
+
+static veil_result render_build(veil_frame* f, veil_stage_report* rep, veil_error* err)
+{
+    (void)rep;
+    const veil_frame_plan* p = &f->plan;
+    const veil_render_opts* o = &p->o;
+    GLuint opv[VEIL_MAX_OPV_TEXTURES];
+    for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) opv[t] = veil_opv_set_texture(f->parts->opv, t);
+    veil_march_desc md = {.medium = lit_medium(f), .camera = o->camera, .width = o->width, .height = o->height,
+                          .step_voxels = o->step_voxels, .seed = o->seed, .skip_empty = !o->no_skip,
+                          .max_distance = o->max_distance, .end_distance = o->behind_distance,
+                          .no_background = o->behind != NULL, .field = &f->field};
+    md.medium.opv = opv;
+    veil_result res = veil_march_run(f->parts->march, &md, f->images, err);
+    if (res == VEIL_OK && o->behind) { /* what is behind, attenuated: T L */
+        veil_image_set* im = f->images;
+        size_t pixels = (size_t)im->width * (size_t)im->height;
+        for (size_t i = 0; i < pixels; ++i)
+            for (int c = 0; c < 3; ++c) im->rgba[4 * i + c] += im->aov_t[4 * i + c] * o->behind[4 * i + c];
+    }
+    return res;
+}
+
+/* ---- spread: screen-space multiple scattering -------------------------- */
+
+/* What the spread moves (docs/multiple-scattering.md): the light from
+ * behind the medium that it scatters without absorbing (veil fog's frame;
+ * the scene's background is a backdrop that lights nothing, as in the
+ * reference path tracer, so it is not spread), and, when the volumetric
+ * estimate is off, the single scattering's light scattered on its way to
+ * the camera (aov_q). With the volumetric estimate on, the medium's higher
+ * orders are its: spreading aov_q too would count them twice. */
+static veil_stage_status spread_decide(const veil_frame_plan* p, int kept, char* w, size_t n)
+{
+    (void)kept;
+    const veil_multiple* m = &p->scene->multiple;
+    if (!m->screen_space) {
+        say(w, n, "off in the scene (multiple_scattering.screen_space)");
+        return VEIL_STAGE_SKIPPED;
+    }
+    if (!p->o.behind && m->volumetric) {
+        say(w, n, "nothing to spread: the volumetric estimate carries the medium's higher orders and the "
+                  "background is a backdrop (veil fog spreads its frame)");
+        return VEIL_STAGE_SKIPPED;
+    }
+    say(w, n, "unless the view is optically thin (max P sigma_s < %g): depends on the camera", m->thin_threshold);
+    return VEIL_STAGE_RAN;
+}
+
+static veil_result spread_build(veil_frame* f, veil_stage_report* rep, veil_error* err)
+{
+    const veil_frame_plan* p = &f->plan;
+    const veil_scene* s = p->scene;
+    const veil_render_opts* o = &p->o;
+    const veil_multiple* m = &s->multiple;
+    veil_image_set* im = f->images;
+    const float* q = m->volumetric ? NULL : im->aov_q;
+    float thick = veil_spread_max_scattering(s, im->aov_t, q, im->width, im->height);
+    if (!(thick >= m->thin_threshold)) {
+        rep->status = VEIL_STAGE_SKIPPED;
+        why(rep, "optically thin view: max P sigma_s = %.3g < thin_threshold %g", thick, m->thin_threshold);
+        return VEIL_OK;
+    }
+    size_t floats = (size_t)im->width * (size_t)im->height * 4;
+    im->aov_m = malloc(floats * sizeof(float));
+    if (!im->aov_m) return veil_fail(err, VEIL_ERR_OOM, "out of memory for the spread image");
+    veil_spread_input in = {.width = im->width, .height = im->height, .L = o->behind, .background = {0, 0, 0},
+                            .aov_t = im->aov_t, .aov_s = im->aov_s, .aov_q = q, .fov_y_deg = o->camera->fov_y_deg};
+    veil_spread_report sr = {0};
+    veil_result res = veil_spread_run(f->parts->spread, s, &in, im->aov_m, NULL, &sr, err);
+    if (res != VEIL_OK) return res;
+    for (size_t i = 0; i < floats; i += 4)
+        for (int c = 0; c < 3; ++c) im->rgba[i + (size_t)c] += im->aov_m[i + (size_t)c];
+    why(rep, "max P sigma_s = %.3g >= %g: spreads %s%s%s; %d levels on %dx%d, %s filter: depends on the camera",
+        thick, m->thin_threshold, o->behind ? "the frame behind" : "", o->behind && q ? " and " : "",
+        q ? "single scattering's out-scattered light" : "", sr.levels, sr.padded_width, sr.padded_height,
+        m->filter == VEIL_SPREAD_2X2 ? "2x2" : m->filter == VEIL_SPREAD_6X6 ? "6x6" : "4x4");
+    return VEIL_OK;
+}
+
+/* ---- the table --------------------------------------------------------- */
+
+const veil_stage_row veil_stage_table[VEIL_STAGE_COUNT] = {
+    {VEIL_STAGE_INJECT, 0, "inject", inject_key, inject_decide, inject_build, inject_settle},
+    {VEIL_STAGE_PROPAGATE, 0, "propagate", propagate_key, propagate_decide, propagate_build, propagate_settle},
+    {VEIL_STAGE_VOLUMETRIC, 0, "multiple scattering", volumetric_key, volumetric_decide, volumetric_build,
+     volumetric_settle},
+    {VEIL_STAGE_RENDER, 1, "march", per_view_key, render_decide, render_build, NULL},
+    {VEIL_STAGE_SPREAD, 1, "spread", per_view_key, spread_decide, spread_build, NULL},
+};

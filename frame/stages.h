@@ -1,0 +1,180 @@
+/* veil — the frame as a table of stages.
+ *
+ *   sources --inject--> extinction volume (volume/ev.h)
+ *           --propagate--> optical depth per light (propagate/opv_set.h)
+ *           --volumetric--> multiply scattered light, view-independent (volumetric/volumetric.h)
+ *           --render--> the march: image set (render/march.h)
+ *           --spread--> screen-space multiple scattering (render/spread.h)
+ *
+ * Each row of veil_stage_table is one stage (frame/stage.h): key() from
+ * descriptions only, decide() without a GPU (ran / cached / skipped and
+ * why, given whether a result with the key is kept), build() (the GPU
+ * work, run only when decide() says "ran"; it may refine the report with
+ * what it measured), and settle() (what the stage leaves to the next rows,
+ * whatever it decided). frame/renderer.c renders a frame by walking the
+ * table; frame/plan.c (`--explain`) walks the same table with the same
+ * keys and decisions and builds nothing. Adding a stage is one row.
+ *
+ * Every setting is resolved once per frame into a veil_frame_plan that the
+ * rows read: the options (veil_render_opts_resolve), then, once the volume
+ * is known (after inject, or from the files' headers when explaining), the
+ * lights that add light and the propagation's parameters
+ * (veil_frame_plan_volume).
+ */
+#ifndef VEIL_STAGES_H
+#define VEIL_STAGES_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../core/result.h"
+#include "../propagate/opv.h"
+#include "../render/image_set.h"
+#include "../scene/scene.h"
+#include "../volume/volume.h"
+#include "../volumetric/volumetric.h"
+#include "stage.h"
+
+/* Jacobi stops when a checked step changes no optical depth sigma_t * D by
+ * more than this (unitless): well under the 8-bit resolution of a preview. */
+#define VEIL_OPV_TAU_TOLERANCE 1e-4f
+
+/* Zero means "default" in every field; veil_render_opts_resolve() says
+ * what zero resolves to. */
+typedef struct veil_render_opts {
+    int width, height;      /* 0: the camera's */
+    float step_voxels;      /* 0: the quality rung's */
+    uint32_t seed;          /* jitter seed */
+    veil_opv_method method; /* 0: the quality rung's */
+    veil_quality quality;   /* UNSET: the scene's "quality", else VEIL_QUALITY_DEFAULT */
+    float sun_across, sun_along; /* light-space grids' node spacing (voxels); 0: the rung's */
+    const veil_camera* camera; /* NULL: the scene's (turntables move it) */
+    int no_skip;            /* 1: march through empty bricks too (to measure what skipping saves) */
+    /* > 0: rays stop at the first step boundary at or beyond this distance
+     * from the camera (m); the steps before it are the same as without it,
+     * so alpha (1 - mean T) is the transmittance of a prefix of the same
+     * march (tests of T along rays). 0: no limit. */
+    float max_distance;
+    /* A frame rendered elsewhere (veil fog): width*height RGBA radiance of
+     * the surfaces behind the medium (replacing the scene's background;
+     * the screen-space spread blurs it) and, per pixel, their distance
+     * along the camera ray (m, >= 0, +inf: nothing there), where each ray
+     * ends. NULL: the scene's background at infinity. */
+    const float* behind;
+    const float* behind_distance;
+} veil_render_opts;
+
+/* opts (NULL: all defaults) with every zero replaced by what it means for
+ * scene s: the one place defaults are resolved. */
+veil_render_opts veil_render_opts_resolve(const veil_render_opts* opts, const veil_scene* s);
+
+/* What a rung of the quality ladder sets (each 0 left to the options). */
+typedef struct veil_quality_rung {
+    float step_voxels;
+    veil_opv_method method;
+    float sun_across, sun_along;
+} veil_quality_rung;
+const veil_quality_rung* veil_quality_rung_of(veil_quality q); /* UNSET: the default rung */
+
+/* The lights of s that add light inside the box of g (NULL: fog only, no
+ * box), in scene order, into out (VEIL_MAX_LIGHTS): zero colour never
+ * does; a spot whose outer cone misses the box's bounding sphere does not. */
+int veil_render_lights(const veil_scene* s, const veil_grid* g, veil_light* out);
+
+/* The propagation parameters for s under resolved options o: the method,
+ * the light-space spacing, the Jacobi tolerance on D that keeps sigma_t D
+ * within VEIL_OPV_TAU_TOLERANCE, and (grid g, a device budget of `budget`
+ * bytes; NULL or 0: none) the memory left for the suns' grids. */
+veil_opv_params veil_render_opv_params(const veil_scene* s, const veil_render_opts* o, const veil_grid* g,
+                                       unsigned long long budget);
+
+/* A frame's plan: every setting resolved once, read by every row. */
+typedef struct veil_frame_plan {
+    const veil_scene* scene;
+    veil_render_opts o;             /* resolved (veil_render_opts_resolve) */
+    int fogs;                       /* analytic fogs (closed form, never voxelised) */
+    unsigned long long budget;      /* the device's memory budget (bytes); 0 when explaining */
+    /* the density given on a grid instead of the scene's sources (veil_render_density); NULL: the sources */
+    const veil_grid* given_grid;
+    const float* given_density;
+    int volume_needed;              /* some source is voxelised (or a density is given) */
+    /* the volume: after inject (a render) or from the files' headers (explaining) */
+    const veil_grid* grid;          /* NULL: none */
+    int sparse;                     /* held sparse (volume/sparse.h) */
+    uint64_t ev_key;                /* inject's key */
+    size_t particles, vdb_voxels;   /* explaining: what the files hold */
+    const char* resolution;         /* explaining: how the grid was chosen */
+    int emission_possible;          /* explaining: the volume glows and emission lights are asked for */
+    /* veil_frame_plan_volume(): the lights that add light (the scene's, then the emission's) */
+    veil_light lights[VEIL_MAX_LIGHTS];
+    int light_count, emission_lights;
+    veil_opv_params opv;            /* the propagation's method and parameters */
+    veil_volumetric_desc volumetric; /* its kind (VEIL_FIELD_NONE: no field wanted) and grid settings */
+} veil_frame_plan;
+
+/* The plan's first step: the options resolved for scene s. */
+void veil_frame_plan_begin(veil_frame_plan* p, const veil_scene* s, const veil_render_opts* opts,
+                           unsigned long long budget);
+
+/* Its second, once the volume is known (g NULL: none): the lights that add
+ * light, then up to `n_emission` of `emission` (the medium's glow as
+ * lights) while there is room, and the propagation's parameters. */
+void veil_frame_plan_volume(veil_frame_plan* p, const veil_grid* g, int sparse, const veil_light* emission,
+                            int n_emission);
+
+/* The GPU objects that hold the stages' results between frames (owned by
+ * the renderer; the rows only use them) and the keys they hold. */
+typedef struct veil_frame_parts {
+    struct veil_ev* ev;
+    struct veil_opv_set* opv;
+    struct veil_volumetric* volumetric;
+    struct veil_march* march;
+    struct veil_spread* spread;
+    uint64_t kept[VEIL_STAGE_COUNT]; /* the key of what each stage holds */
+    int has[VEIL_STAGE_COUNT];       /* 1: it holds a result (an empty medium included) */
+    int opv_textures;                /* textures the kept optical depths use */
+    size_t particles;                /* the kept EV's RBF particles (for the report) */
+} veil_frame_parts;
+
+typedef struct veil_render_stats {
+    veil_stage_report stage[VEIL_STAGE_COUNT];
+    double inject_ms, propagate_ms, render_ms; /* = stage[...].ms */
+    int width, height;    /* the image's size */
+    int has_volume;       /* 0: nothing to inject (empty medium) */
+    int inject_cached;    /* the EV was reused */
+    veil_grid grid;       /* the EV's geometry when has_volume */
+    size_t particles;
+    size_t vdb_voxels;    /* active voxels of the OpenVDB grids (0 when cached) */
+    int lights_used;      /* lights that reach the medium and add light (with the emission's) */
+    int emission_lights;  /* of them, the medium's emission as lights (volume/emission_lights.h) */
+    int fogs;             /* analytic fogs (closed form, never voxelised) */
+    int opv_computed, opv_cached; /* OPV textures made / reused */
+    veil_opv_method method;
+    int propagate_iterations; /* Jacobi steps or sweep passes (most of any light) */
+} veil_render_stats;
+
+/* One frame in flight: the plan and, in a render, where the rows work. */
+typedef struct veil_frame {
+    veil_frame_plan plan;
+    veil_frame_parts* parts;         /* NULL when explaining */
+    veil_render_stats* st;           /* a render's report (NULL when explaining) */
+    veil_image_set* images;          /* the march's output */
+    veil_volumetric_field field;     /* the volumetric stage's field for the march */
+} veil_frame;
+
+/* A row of the table. decide() and key() read only the plan and never a
+ * GPU; `kept` is 1 when the stage holds a result with this key. */
+typedef struct veil_stage_row {
+    veil_stage_id id;
+    int per_view; /* 1: depends on the camera: runs every frame, holds nothing */
+    const char* doing; /* what the progress line says while it works */
+    uint64_t (*key)(const veil_frame_plan* p);
+    veil_stage_status (*decide)(const veil_frame_plan* p, int kept, char* why, size_t n);
+    veil_result (*build)(veil_frame* f, veil_stage_report* rep, veil_error* err);
+    void (*settle)(veil_frame* f, const veil_stage_report* rep); /* NULL: nothing to leave */
+} veil_stage_row;
+
+/* The table, in pipeline order (row i is stage i). */
+extern const veil_stage_row veil_stage_table[VEIL_STAGE_COUNT];
+
+#endif
