@@ -1,15 +1,18 @@
-/* veil — the command-line tool.
+/* veil — the command-line tool. main() dispatches each command to its file:
  *
- *   veil render SCENE.json -o OUT.exr [--png OUT.png] [--width W] [--height H]
- *               [--quality Q] [--step S] [--od-spacing A[,B]] [--seed N] [--method M]
- *               [--turntable N] [--aovs] [--stats] [--explain]
- *   veil gpuinfo
- *   veil info FILE.vdb [--json]
- *   veil rbf generate -o OUT --count N --seed S --bounds x0,y0,z0,x1,y1,z1
- *               --radius r0,r1 --amplitude c0,c1 [--noise-scale L]
- *               [--noise-octaves K] [--noise-amount A] [--format json|binary]
+ *   veil render      a scene to an EXR (and a PNG preview)       cli/render.c
+ *   veil turntable   frames on an orbit, a sequence, farm shards cli/turntable.c
+ *   veil reference   the CPU path tracer's ground truth          cli/reference.c
+ *   veil compare     an image against a reference                cli/compare.c
+ *   veil fog         the medium added to a frame made elsewhere  cli/fog.c
+ *   veil info        the grids of an OpenVDB or NanoVDB file     cli/info.c
+ *   veil gpuinfo     the EGL device and GL context veil gets     cli/gpuinfo.c
+ *   veil rbf generate  a seeded random particle file             cli/rbf.c
  *   veil --help | --version
  *
+ * Each command's usage is usage_text below, the README's command block
+ * ("## The command") line for line; ctest cli_docs fails when the two, the
+ * dispatch, this list or a command's parsed options drift apart.
  * Exit codes: 0 success, 1 bad input (scene, file), 2 usage, 3 GPU/driver.
  * Messages go to stderr; the written paths and the time to stdout.
  */
@@ -26,20 +29,20 @@ static const char* usage_text =
     "                   [--quality Q] [--step S] [--od-spacing A[,B]] [--seed N] [--method M]\n"
     "                   [--turntable N] [--aovs] [--stats] [--explain]\n"
     "       veil turntable SCENE.json -o OUT.####.exr [--frames N | --range A-B[xS]] [--png OUT.####.png]\n"
-    "                [--axis X,Y,Z] [--start DEG] [--degrees DEG] [--elevation DEG] [--shard I/N]\n"
-    "                [--skip-existing] [--skip-missing] [--quality Q] [--step S] [--seed N] [--width W] [--height H]\n"
-    "                [--method M] [--contact-sheet OUT.png] [--movie OUT.mp4|gif] [--fps F]\n"
-    "                [--aovs] [--stats] [--explain] [--quiet | --progress]\n"
-    "       veil reference SCENE.json -o REF.exr --spp N [--max-order K] [--width W]\n"
-    "                [--height H] [--seed N] [--threads T] [--light-sampling distance|mis]\n"
+    "                      [--axis X,Y,Z] [--start DEG] [--degrees DEG] [--elevation DEG] [--shard I/N]\n"
+    "                      [--skip-existing] [--skip-missing] [--quality Q] [--step S] [--seed N]\n"
+    "                      [--width W] [--height H] [--method M] [--contact-sheet OUT.png]\n"
+    "                      [--movie OUT.mp4|gif] [--fps F] [--aovs] [--stats] [--explain] [--quiet | --progress]\n"
+    "       veil reference SCENE.json -o REF.exr --spp N [--max-order K] [--width W] [--height H]\n"
+    "                      [--seed N] [--threads T] [--light-sampling distance|mis]\n"
     "       veil compare A.exr REF.exr [--heatmap OUT.png] [--floor F] [--bin B] [--json]\n"
-    "       veil fog FRAME.exr --scene SCENE.json -o OUT.exr [--png OUT.png]\n"
-    "                [--depth-channel NAME] [--depth-is z|distance] [--aovs] [--stats]\n"
-    "       veil gpuinfo\n"
+    "       veil fog FRAME.exr --scene SCENE.json -o OUT.exr [--png OUT.png] [--depth-channel NAME]\n"
+    "                [--depth-is z|distance] [--aovs] [--stats]\n"
     "       veil info FILE.vdb [--json]\n"
+    "       veil gpuinfo\n"
     "       veil rbf generate -o OUT --count N --seed S --bounds x0,y0,z0,x1,y1,z1\n"
-    "                --radius r0,r1 --amplitude c0,c1 [--noise-scale L] [--noise-octaves K]\n"
-    "                [--noise-amount A] [--format json|binary]\n"
+    "                         --radius r0,r1 --amplitude c0,c1 [--noise-scale L] [--noise-octaves K]\n"
+    "                         [--noise-amount A] [--format json|binary]\n"
     "       veil --help | --version\n"
     "\n"
     "render   renders a scene (docs/scene-format.md) to an HDR EXR (R, G, B, A = 1 - mean\n"
@@ -114,11 +117,12 @@ static const char* usage_text =
     "  --depth-channel NAME  the depth channel (default: the first of Z, depth.Z,\n"
     "                 depth, distance); +inf where nothing was hit\n"
     "  --depth-is z|distance  depth along the view axis (default) or along the ray\n"
+    "info     lists the grids of an OpenVDB (or NanoVDB .nvdb) file: name, class, value\n"
+    "         type, active voxels, index and world bounding boxes, voxel size and transform,\n"
+    "         and whether render copies it at its own voxels, holds it sparse or resamples it.\n"
+    "  --json         print them as JSON instead of a table\n"
     "gpuinfo  prints the EGL platform and device, GL vendor, renderer, version and\n"
     "         the largest 3D texture. VEIL_DEVICE=software forces llvmpipe.\n"
-    "info     lists the grids of an OpenVDB file: name, class, value type, active\n"
-    "         voxels, index and world bounding boxes, voxel size and transform.\n"
-    "  --json         print them as JSON instead of a table\n"
     "rbf generate  writes a seeded random particle file (docs/particles.md) for an\n"
     "         \"rbf\" source's \"file\": N particles (0..10000000), centres uniform in\n"
     "         the box, radius (1/sharpness, m) and amplitude uniform in their ranges;\n"

@@ -14,8 +14,12 @@
 # Environment: VEIL (the veil program on the nodes; default the one on
 # PATH, else this checkout's build/veil), MOVIE (default OUT's name before
 # the frame number + .mp4; empty: no movie), SHEET (likewise + _sheet.png),
-# SBATCH_ARGS (more sbatch options for every job: --partition, --time,
-# --cpus-per-task, --gres=gpu:1 ...). Prints the two job ids.
+# LOGS (the folder for the jobs' logs, made if missing; default logs/ in
+# OUT's folder, beside the frames: veil-frames_JOB_TASK.out for each array
+# task, veil-review_JOB.out for the review job, never slurm-*.out in the
+# folder sbatch ran from), SBATCH_ARGS (more sbatch options for every job:
+# --partition, --time, --cpus-per-task, --gres=gpu:1 ...). Prints the two
+# job ids and the logs' folder.
 #
 # Frames are renamed into place whole and each frame's bytes depend only on
 # the scene and its number, so a re-queued task (Slurm's requeue, or
@@ -27,7 +31,7 @@
 # is one, llvmpipe otherwise).
 set -euo pipefail
 if [ $# -lt 4 ]; then
-  sed -n '2,30p' "$0" >&2
+  awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0" >&2 # the header above
   exit 2
 fi
 scene=$1 out=$2 range=$3 tasks=$4
@@ -44,14 +48,22 @@ stem=${stem%%\%*}
 stem=${stem%.}
 movie=${MOVIE-$stem.mp4}
 sheet=${SHEET-${stem}_sheet.png}
+# Slurm does not make an --output folder (a job whose log cannot be opened
+# fails without a word), so it is made here, and named absolutely: the jobs
+# may start in another folder than this one.
+logs=${LOGS:-$(dirname -- "$out")/logs}
+mkdir -p -- "$logs" || { echo "slurm-turntable: cannot make the logs' folder '$logs' (set LOGS)" >&2; exit 2; }
+logs=$(cd -- "$logs" && pwd)
 q() { printf '%q ' "$@"; } # quoted for the job's shell
 # shellcheck disable=SC2086
 array=$(sbatch --parsable ${SBATCH_ARGS:-} --job-name=veil-frames --array=1-"$tasks" \
+  --output="$logs/veil-frames_%A_%a.out" \
   --wrap "$(q "$veil" turntable "$scene" -o "$out" --range "$range" --skip-existing "${extra[@]}") --shard \$SLURM_ARRAY_TASK_ID/$tasks")
 review=()
 [ -n "$sheet" ] && review+=(--contact-sheet "$sheet")
 [ -n "$movie" ] && review+=(--movie "$movie")
 # shellcheck disable=SC2086
 assemble=$(sbatch --parsable ${SBATCH_ARGS:-} --job-name=veil-review --dependency=afterok:"${array%%;*}" \
+  --output="$logs/veil-review_%j.out" \
   --wrap "$(q "$veil" turntable "$scene" -o "$out" --range "$range" --skip-existing "${extra[@]}" "${review[@]}")")
-echo "frames: job array ${array%%;*} ($tasks tasks); review: job ${assemble%%;*} (after all of them)"
+echo "frames: job array ${array%%;*} ($tasks tasks); review: job ${assemble%%;*} (after all of them); logs: $logs"

@@ -3,7 +3,9 @@
 # slurmctld and slurmd on localhost, state and spool in a temporary folder,
 # stopped by their PIDs at the end), scripts/slurm-turntable.sh submitting
 # a job array of shards and the review job after them. The frames must be
-# byte for byte those of one local run, and the contact sheet must exist.
+# byte for byte those of one local run, and the contact sheet must exist;
+# the jobs' logs must land in logs/ beside the frames (or in LOGS when it
+# names a folder), never in the folder the script was run from.
 # Skipped (exit 77) without the Debian packages slurm-wlm and munge, or when
 # not root (slurmd runs jobs as their users: the test's user must be root to
 # run the daemons without systemd). Usage: farm_test.sh VEIL SCENE ROOT
@@ -85,21 +87,42 @@ done
 
 # the turntable: 6 frames over 2 array tasks, then the review job
 out=$tmp/frames
-mkdir -p "$out" "$tmp/local"
+mkdir -p "$out" "$tmp/local" "$tmp/submit"
 opts=(--width 40 --height 30 --degrees 90 --seed 3)
-SHEET="$tmp/sheet.png" MOVIE="" VEIL="$veil" bash "$root/scripts/slurm-turntable.sh" "$scene" "$out/f.####.exr" 1-6 2 \
-  -- "${opts[@]}" > "$tmp/submit.log" 2>&1 || fail "submit: $(cat "$tmp/submit.log")"
-for _ in $(seq 300); do
-  [ -z "$(squeue -h 2> /dev/null)" ] && break
-  sleep 0.5
-done
-[ -z "$(squeue -h 2> /dev/null)" ] || fail "jobs still queued after 150 s: $(squeue 2>&1)"
+wait_queue() {
+  for _ in $(seq 300); do
+    [ -z "$(squeue -h 2> /dev/null)" ] && return 0
+    sleep 0.5
+  done
+  fail "jobs still queued after 150 s: $(squeue 2>&1)"
+}
+# submitted from a folder of its own, where Slurm would write slurm-*.out without --output
+(cd "$tmp/submit" && SHEET="$tmp/sheet.png" MOVIE="" VEIL="$veil" bash "$root/scripts/slurm-turntable.sh" "$scene" \
+  "$out/f.####.exr" 1-6 2 -- "${opts[@]}") > "$tmp/submit.log" 2>&1 || fail "submit: $(cat "$tmp/submit.log")"
+wait_queue
 "$veil" turntable "$scene" -o "$tmp/local/f.####.exr" --range 1-6 "${opts[@]}" > /dev/null || fail "local run"
 for f in 1 2 3 4 5 6; do
   cmp -s "$out/f.000$f.exr" "$tmp/local/f.000$f.exr" || fail "frame $f differs from one local run (or is missing)"
 done
 [ -s "$tmp/sheet.png" ] || fail "the review job made no contact sheet"
-echo "PASS: 6 frames from 2 array tasks, the same bytes as one local run; the review job's contact sheet"
+# the logs: by default in logs/ beside the frames, one a task and one for the review job
+n=$(find "$out/logs" -name 'veil-frames_*.out' 2> /dev/null | wc -l)
+[ "$n" -eq 2 ] || fail "$n frame tasks' logs in $out/logs, expected 2: $(ls -A "$out" "$out/logs" 2>&1)"
+n=$(find "$out/logs" -name 'veil-review_*.out' 2> /dev/null | wc -l)
+[ "$n" -eq 1 ] || fail "$n review jobs' logs in $out/logs, expected 1"
+grep -q "shard 1/2" "$out"/logs/veil-frames_*_1.out || fail "the first task's log does not hold its turntable line"
+# again with LOGS: every frame is there (--skip-existing), so the jobs only log, into the named folder
+(cd "$tmp/submit" && LOGS="$tmp/named-logs" SHEET="" MOVIE="" VEIL="$veil" bash "$root/scripts/slurm-turntable.sh" \
+  "$scene" "$out/f.####.exr" 1-6 1 -- "${opts[@]}") > "$tmp/submit2.log" 2>&1 || fail "submit with LOGS: $(cat "$tmp/submit2.log")"
+wait_queue
+n=$(find "$tmp/named-logs" -name 'veil-*.out' 2> /dev/null | wc -l)
+[ "$n" -eq 2 ] || fail "$n logs in LOGS=$tmp/named-logs, expected 2 (one task, the review job)"
+n=$(find "$out/logs" -name 'veil-*.out' | wc -l)
+[ "$n" -eq 3 ] || fail "the run with LOGS also wrote into logs/ beside the frames ($n logs there, expected 3)"
+stray=$(find "$tmp/submit" -name 'slurm-*.out')
+[ -z "$stray" ] || fail "logs in the folder the script ran from: $stray"
+echo "PASS: 6 frames from 2 array tasks, the same bytes as one local run; the review job's contact sheet;"
+echo "      the logs beside the frames (or in LOGS), none where the script ran"
 
 # bench/farm: with FARM_BENCH_SCENE and FARM_BENCH_FRAMES, the time from submission to an empty queue
 # for 1 and 2 array tasks on this cluster (docs/performance.md)

@@ -2,8 +2,8 @@
 # The installed library: `cmake --install` into a temporary prefix, then the
 # example (examples/render_scene.c) built against it twice, through the
 # CMake package (find_package(veil)) and through pkg-config; the installed
-# tree holds the tool, libveil.so, the two public headers and the package
-# files, and nothing else under include/; both builds render the demo scene
+# tree holds the tool, libveil.so, the two public headers, the package
+# files and the licence, and nothing else under include/; both builds render the demo scene
 # to the same bytes (same scene, same seed).
 # Exit 77 (skipped) when no GL context can be made, except under CI=true.
 #   install_example.sh BUILD_DIR SOURCE_DIR
@@ -26,6 +26,7 @@ for f in bin/veil lib/libveil.so include/veil.h include/veil/result.h lib/cmake/
          lib/cmake/veil/veilConfigVersion.cmake lib/pkgconfig/veil.pc; do
   [ -e "$prefix/$f" ] || fail "the installed tree has no $f"
 done
+[ -s "$prefix/share/doc/veil/LICENSE" ] || fail "the installed tree has no share/doc/veil/LICENSE"
 extra=$(cd "$prefix/include" && find . -mindepth 1 ! -path ./veil.h ! -path ./veil ! -path ./veil/result.h)
 [ -z "$extra" ] || fail "include/ holds more than the public headers: $extra"
 
