@@ -1,6 +1,6 @@
 # `veil compare` (reference/compare.c, cli/compare.c): the metrics against
 # values worked out independently, the heatmap's colour map and PNG writer,
-# and the command end to end (tests/compare_cli.sh, on EXRs that
+# and the command end to end (tests/cli/compare_cli.sh, on EXRs that
 # make_compare_exrs writes at test time).
 veil_test(test_compare SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_compare.c LABELS unit)
 target_link_libraries(test_compare PRIVATE PkgConfig::PNG)

@@ -14,17 +14,17 @@ add_test(NAME cli_end_to_end
           ${PROJECT_SOURCE_DIR}/data/scenes/demo.json $<TARGET_FILE:exr_stats>)
 set_tests_properties(cli_end_to_end PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)
 # Output paths (issue 12): never the input, never two outputs in one file, never
-# an existing output lost when the PNG fails after the EXR (tests/output_paths.sh).
+# an existing output lost when the PNG fails after the EXR (tests/cli/output_paths.sh).
 add_test(NAME cli_output_paths
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/output_paths.sh $<TARGET_FILE:veil_cli>
           ${PROJECT_SOURCE_DIR}/data/scenes/height_fog.json)
 set_tests_properties(cli_output_paths PROPERTIES LABELS "gpu;cli;bad_input" SKIP_RETURN_CODE 77)
-# A status line on a terminal for the work under way, none in a pipe (tests/progress_tty.sh).
+# A status line on a terminal for the work under way, none in a pipe (tests/cli/progress_tty.sh).
 add_test(NAME cli_progress_tty
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/progress_tty.sh $<TARGET_FILE:veil_cli>
           ${PROJECT_SOURCE_DIR}/data/scenes/rbf_fog.json)
 set_tests_properties(cli_progress_tty PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)
-# The march in bands of rows equals one dispatch, bit for bit (tests/test_march_bands.c).
+# The march in bands of rows equals one dispatch, bit for bit (tests/render/test_march_bands.c).
 veil_test(test_march_bands SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_march_bands.c LABELS gpu
           ARGS ${PROJECT_SOURCE_DIR}/data/scenes/rbf_fog.json)
 veil_test(test_render_cache SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_render_cache.c LABELS gpu)
@@ -58,7 +58,7 @@ veil_test(test_diffusion SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_diffusion.c LA
 add_test(NAME cli_turntable
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/turntable_cli.sh $<TARGET_FILE:veil_cli> ${PROJECT_SOURCE_DIR}/data/scenes/rbf_fog.json)
 set_tests_properties(cli_turntable PROPERTIES LABELS "gpu;cli" SKIP_RETURN_CODE 77)
-# A turntable on a one-node Slurm started by the test (tests/farm_test.sh): label farm,
+# A turntable on a one-node Slurm started by the test (tests/cli/farm_test.sh): label farm,
 # not part of make test; make test-farm installs slurm-wlm and munge and runs it.
 add_test(NAME farm_slurm_turntable
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/farm_test.sh $<TARGET_FILE:veil_cli> ${PROJECT_SOURCE_DIR}/data/scenes/rbf_fog.json

@@ -1,4 +1,4 @@
-# The installed tree (tests/install_example.sh): cmake --install into a
+# The installed tree (tests/api/install_example.sh): cmake --install into a
 # temporary prefix, examples/ built against it through the CMake package and
 # through pkg-config, both run on the demo scene.
 add_test(NAME install_example

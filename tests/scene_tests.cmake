@@ -3,7 +3,7 @@
 veil_test(test_scene SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_scene.c LABELS unit)
 
 # bad_input_<stem>: `veil render SCENE` must exit 1, print EXPECTED on stderr
-# and write no file (tests/bad_input.sh).
+# and write no file (tests/support/bad_input.sh).
 function(veil_bad_input stem scene expected)
   add_test(NAME bad_input_${stem}
            COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/bad_input.sh $<TARGET_FILE:veil_cli> ${scene} "${expected}")

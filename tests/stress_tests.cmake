@@ -1,4 +1,4 @@
-# Stress: 500 seeded random extreme scenes (tests/test_stress.c) through
+# Stress: 500 seeded random extreme scenes (tests/frame/test_stress.c) through
 # parse, inject, propagate and march on one renderer, the CPU optical-depth
 # reference and the CPU path tracer: finite output, alpha in [0, 1], T
 # non-increasing along rays, optical depths finite, >= 0 and monotone.

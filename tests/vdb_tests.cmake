@@ -9,7 +9,7 @@ target_link_libraries(make_test_vdbs PRIVATE veil_openvdb veil_warnings)
 add_test(NAME vdb_generate COMMAND make_test_vdbs ${VDB_DATA})
 set_tests_properties(vdb_generate PROPERTIES FIXTURES_SETUP vdb_data LABELS unit)
 
-# test_vdb DATA CASE: one ctest per case (tests/test_vdb.c).
+# test_vdb DATA CASE: one ctest per case (tests/io/test_vdb.c).
 add_executable(test_vdb ${CMAKE_CURRENT_SOURCE_DIR}/test_vdb.c ${CMAKE_CURRENT_SOURCE_DIR}/check.c)
 target_link_libraries(test_vdb PRIVATE veil veil_fp veil_warnings)
 function(veil_vdb_case name labels)
@@ -38,7 +38,7 @@ veil_vdb_case(limits unit)
 # a scene's VDB source: veil_scene_volume_open with err == NULL on a missing
 # and a corrupt file; veil_scene_volume_key is the file's identity, not its bytes
 veil_vdb_case(scene_volume unit)
-# Importing as production makes them (tests/test_vdb_import.c): native
+# Importing as production makes them (tests/volume/test_vdb_import.c): native
 # resolution (a VDB without max_resolution keeps its voxels, values copied),
 # NanoVDB and half-float files read exactly, the resampling filter by direction.
 add_executable(test_vdb_import ${CMAKE_CURRENT_SOURCE_DIR}/test_vdb_import.c ${CMAKE_CURRENT_SOURCE_DIR}/check.c)
@@ -48,7 +48,7 @@ foreach(case native nanovdb filters)
   set_tests_properties(vdb_${case} PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "unit;accuracy")
 endforeach()
 
-# Trees checked before OpenVDB reads them (tests/test_vdb_trees.c): every
+# Trees checked before OpenVDB reads them (tests/io/test_vdb_trees.c): every
 # grid type under every compression reads; absurd claims inside a tree are
 # refused by the check.
 add_executable(test_vdb_trees ${CMAKE_CURRENT_SOURCE_DIR}/test_vdb_trees.c ${CMAKE_CURRENT_SOURCE_DIR}/check.c)
@@ -58,18 +58,18 @@ foreach(case types corrupt)
   set_tests_properties(vdb_trees_${case} PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "unit;bad_input")
 endforeach()
 
-# Truncated files fail fast and small, naming the file (tests/vdb_truncated.sh).
+# Truncated files fail fast and small, naming the file (tests/io/vdb_truncated.sh).
 add_test(NAME vdb_truncated COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/vdb_truncated.sh $<TARGET_FILE:veil_cli>
                                    ${VDB_DATA}/fog_sphere.vdb)
 set_tests_properties(vdb_truncated PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "gpu;bad_input")
 
 # The fuzz corpus (tests/fuzz/corpus/: seeds and the inputs fuzzing found) as
-# regression inputs of every build (tests/fuzz_corpus.sh).
+# regression inputs of every build (tests/fuzz/fuzz_corpus.sh).
 add_test(NAME fuzz_corpus COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/fuzz_corpus.sh $<TARGET_FILE:veil_cli>
                                  ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/corpus)
 set_tests_properties(fuzz_corpus PROPERTIES LABELS "bad_input")
 
-# The sparse volume (tests/test_sparse.c): the 4096^3 puffs file against its crop.
+# The sparse volume (tests/volume/test_sparse.c): the 4096^3 puffs file against its crop.
 add_executable(test_sparse ${CMAKE_CURRENT_SOURCE_DIR}/test_sparse.c ${CMAKE_CURRENT_SOURCE_DIR}/check.c)
 target_link_libraries(test_sparse PRIVATE veil veil_fp veil_warnings)
 add_test(NAME sparse_structure COMMAND test_sparse ${VDB_DATA} structure)
@@ -79,7 +79,7 @@ foreach(case depth render emission)
   set_tests_properties(sparse_${case} PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "gpu;accuracy" SKIP_RETURN_CODE 77)
 endforeach()
 
-# `veil info` (tests/vdb_bad.sh VEIL EXPECTED_EXIT EXPECTED_TEXT ARGS...).
+# `veil info` (tests/cli/vdb_bad.sh VEIL EXPECTED_EXIT EXPECTED_TEXT ARGS...).
 function(veil_vdb_cli name rc text)
   add_test(NAME vdb_cli_${name}
            COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/vdb_bad.sh $<TARGET_FILE:veil_cli> ${rc} "${text}" ${ARGN})
@@ -106,7 +106,7 @@ veil_vdb_cli(info_missing 1 "does_not_exist.vdb: cannot open: No such file or di
 veil_vdb_cli(info_usage 2 "info: missing FILE.vdb" info)
 
 # A sparse volume asked for where there cannot be one (a rotated grid): exit 1
-# naming the field and why, nothing written (tests/bad_input.sh).
+# naming the field and why, nothing written (tests/support/bad_input.sh).
 file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/bad_sparse_rotated.json
   "{\"camera\": {\"position\": [0, 0, 3], \"look_at\": [0, 0, 0], \"width\": 8, \"height\": 6},
     \"medium\": {\"sigma_s\": [1, 1, 1], \"representation\": \"sparse\",
@@ -143,7 +143,7 @@ veil_vdb_cli(render_emission_lights 0 "1 of 1 lights (+8 from the emission)" ren
 set_tests_properties(vdb_cli_render_emission_lights PROPERTIES LABELS "cli;gpu")
 
 # A vdb source's emission or temperature grid that the file lacks: exit 1 naming
-# the field and the file's grids, nothing written (tests/bad_input.sh).
+# the field and the file's grids, nothing written (tests/support/bad_input.sh).
 foreach(field emission temperature)
   file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/bad_${field}_grid.json
     "{\"camera\": {\"position\": [0, 0, 3], \"look_at\": [0, 0, 0], \"width\": 8, \"height\": 6},
@@ -155,7 +155,7 @@ foreach(field emission temperature)
                    "medium.sources[0].${field}.grid: ${VDB_DATA}/emissive_slab.vdb: no grid named 'nope'")
   set_tests_properties(bad_input_${field}_grid PROPERTIES FIXTURES_REQUIRED vdb_data LABELS bad_input)
 endforeach()
-# An animated source: one VDB a frame through veil turntable (tests/turntable_sequence.sh).
+# An animated source: one VDB a frame through veil turntable (tests/cli/turntable_sequence.sh).
 add_test(NAME cli_turntable_sequence
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/turntable_sequence.sh $<TARGET_FILE:veil_cli> ${VDB_DATA})
 set_tests_properties(cli_turntable_sequence PROPERTIES FIXTURES_REQUIRED vdb_data LABELS "gpu;cli" SKIP_RETURN_CODE 77)
