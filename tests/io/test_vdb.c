@@ -3,7 +3,7 @@
  *
  *   test_vdb DATA_DIR CASE
  *
- * One ctest per CASE (tests/vdb_tests.cmake): open, select, level_set,
+ * One ctest per CASE (tests/io/CMakeLists.txt): open, select, level_set,
  * types, bad_files, empty, transform, threads, fast_path, mass, rotated,
  * limits, scene_volume. (Native resolution, NanoVDB files and the
  * filter by direction: tests/volume/test_vdb_import.c.)

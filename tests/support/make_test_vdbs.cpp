@@ -1,5 +1,6 @@
-// veil tests — writes the OpenVDB files that tests/io/test_vdb.c and
-// the vdb tests of tests/io, tests/volume and tests/cli read, so that no binary test data is committed.
+// veil tests — writes the OpenVDB files that the VDB tests read (the
+// vdb_data fixture of tests/io/, tests/volume/, tests/render/, tests/scene/
+// and tests/cli/), so that no binary test data is committed.
 //
 //   make_test_vdbs DIR           the test files (below), deterministic
 //   make_test_vdbs DIR --big     also big_plume.vdb (~10^6 active voxels, for timing)
