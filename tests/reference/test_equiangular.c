@@ -477,12 +477,10 @@ static void test_single_quadrature(int spot)
 /* The airlight closed form of tests/reference/test_pathtracer.c, both strategies. */
 static void test_airlight_both(void)
 {
-    veil_scene s = test_parse_scene(
-        "{\"camera\":{\"position\":[0,0,0],\"look_at\":[2,0.5,0],\"width\":1,\"height\":1},"
-        "\"medium\":{\"sigma_a\":[0.1,0.05,0.0],\"sigma_s\":[0.2,0.3,0.4],\"sources\":[{\"type\":\"exponential\","
-        "\"density\":1,\"falloff\":0,\"direction\":[0,1,0],\"origin\":[0,0,0],\"bounds\":[[-20,-20,-20],[20,20,20]]}]},"
-        "\"lights\":[{\"type\":\"point\",\"position\":[0,1,0],\"intensity\":[10,10,10]}],"
-        "\"background\":{\"color\":[0,0,0]}}");
+    /* tests/data/scenes/airlight_point.json: viewer at the origin looking along
+     * (2, 0.5, 0); a point light of intensity 10 at (0, 1, 0); homogeneous fog of
+     * density 1 filling [-20, 20]^3: the ray leaves it at x = 20 */
+    veil_scene s = test_load_scene("airlight_point.json");
     veil_pt_medium* m = NULL;
     veil_error err = {0};
     CHECK(veil_pt_medium_from_scene(&s, &m, &err) == VEIL_OK, "%s", err.msg);

@@ -146,11 +146,9 @@ static void test_sun_single(void)
 
 static void test_exp_fog(void)
 {
-    veil_scene s = test_parse_scene(
-        "{\"camera\":{\"position\":[-4,2.5,0.3],\"look_at\":[4,-0.5,-0.2],\"width\":1,\"height\":1},"
-        "\"medium\":{\"sigma_a\":[0.2,0.0,0.4],\"sigma_s\":[0.6,0.9,0.3],\"sources\":[{\"type\":\"exponential\","
-        "\"density\":0.8,\"falloff\":1.5,\"direction\":[0,1,0],\"origin\":[0,0,0],\"bounds\":[[-5,-1,-5],[5,3,5]]}]},"
-        "\"lights\":[],\"background\":{\"color\":[1,1,1]}}");
+    /* tests/data/scenes/slanted_fog.json: fog of density 0.8 e^{-1.5 y} in the box
+     * [-5, 5] x [-1, 3] x [-5, 5] (lo, hi, b and rho0 below), seen along a slanted ray */
+    veil_scene s = test_load_scene("slanted_fog.json");
     veil_pt_medium* m = NULL;
     veil_error err = {0};
     CHECK(veil_pt_medium_from_scene(&s, &m, &err) == VEIL_OK, "%s", err.msg);
@@ -220,14 +218,10 @@ static void test_gaussian(void)
 
 static void test_airlight(void)
 {
-    /* viewer at the origin looking along (2, 0.5, 0); light at (0, 1, 0);
-     * homogeneous fog filling [-20, 20]^3: the ray leaves it at x = 20 */
-    veil_scene s = test_parse_scene(
-        "{\"camera\":{\"position\":[0,0,0],\"look_at\":[2,0.5,0],\"width\":1,\"height\":1},"
-        "\"medium\":{\"sigma_a\":[0.1,0.05,0.0],\"sigma_s\":[0.2,0.3,0.4],\"sources\":[{\"type\":\"exponential\","
-        "\"density\":1,\"falloff\":0,\"direction\":[0,1,0],\"origin\":[0,0,0],\"bounds\":[[-20,-20,-20],[20,20,20]]}]},"
-        "\"lights\":[{\"type\":\"point\",\"position\":[0,1,0],\"intensity\":[10,10,10]}],"
-        "\"background\":{\"color\":[0,0,0]}}");
+    /* tests/data/scenes/airlight_point.json: viewer at the origin looking along
+     * (2, 0.5, 0); a point light of intensity 10 at (0, 1, 0); homogeneous fog of
+     * density 1 filling [-20, 20]^3: the ray leaves it at x = 20 */
+    veil_scene s = test_load_scene("airlight_point.json");
     veil_pt_medium* m = NULL;
     veil_error err = {0};
     CHECK(veil_pt_medium_from_scene(&s, &m, &err) == VEIL_OK, "%s", err.msg);

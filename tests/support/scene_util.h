@@ -1,4 +1,5 @@
-/* veil tests — a scene from a JSON string, and the ray of a 1x1 image. */
+/* veil tests — a scene from a JSON string or from a shared test scene of
+ * tests/data/scenes/, and the ray of a 1x1 image. */
 #ifndef VEIL_TEST_SCENE_UTIL_H
 #define VEIL_TEST_SCENE_UTIL_H
 
@@ -22,14 +23,33 @@ static inline veil_scene test_parse_scene(const char* json)
     return s;
 }
 
-/* The same with multiple scattering off: the scene as the single-scattering
- * march sees it (the closed forms of single scattering and transmittance). */
-static inline veil_scene test_parse_scene_single(const char* json)
+/* A scene several tests share, tests/data/scenes/NAME (VEIL_TEST_SCENES is
+ * that folder, defined by tests/support/CMakeLists.txt), or exits 1. */
+static inline veil_scene test_load_scene(const char* name)
 {
-    veil_scene s = test_parse_scene(json);
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s", VEIL_TEST_SCENES, name);
+    veil_scene s;
+    veil_error e = {0};
+    if (veil_scene_load(path, &s, &e) != VEIL_OK) {
+        fprintf(stderr, "scene: %s\n", e.msg);
+        exit(1);
+    }
+    return s;
+}
+
+/* s with multiple scattering off: the scene as the single-scattering march
+ * sees it (the closed forms of single scattering and transmittance). */
+static inline veil_scene test_single_scattering(veil_scene s)
+{
     s.multiple.screen_space = 0;
     s.multiple.volumetric = 0;
     return s;
+}
+
+static inline veil_scene test_parse_scene_single(const char* json)
+{
+    return test_single_scattering(test_parse_scene(json));
 }
 
 /* The ray of a 1x1 image as the renderers form it (float camera, then
