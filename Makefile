@@ -6,7 +6,7 @@
 #   make accuracy  time against error of the GPU path vs the CPU reference
 #                  (bench/accuracy --quick, under 2 minutes; FULL=1: the full sweep)
 #   make test-farm  a turntable on a one-node Slurm cluster started on this machine
-#               (installs slurm-wlm, munge and ffmpeg; tests/farm_test.sh; run as root)
+#               (installs slurm-wlm, munge and ffmpeg; tests/cli/farm_test.sh; run as root)
 #   make peers  veil against OpenVDB's vdb_render, time against error on three VDBs
 #               (bench/peers.py: installs libopenvdb-tools and gnuplot; ~30 minutes the
 #               first time, the references then cached; PEERS_ARGS="--quick": minutes)
@@ -15,7 +15,7 @@
 #               UBSan, in build-fuzz/ (scripts/fuzz.sh)
 #   make test-sanitize  every test built with AddressSanitizer and UndefinedBehaviorSanitizer
 #                  (undefined behaviour fatal) in build-sanitize/; leaks in Mesa and LLVM
-#                  (the GL driver) suppressed by tests/lsan.supp, never veil's; the driver is
+#                  (the GL driver) suppressed by tests/support/lsan.supp, never veil's; the driver is
 #                  preloaded, so never unloaded, so its leaks have names to suppress
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
@@ -78,7 +78,7 @@ test-sanitize:
 	@cmake --build build-sanitize -j $(JOBS) -- --no-print-directory
 	@cd build-sanitize && LD_PRELOAD=$(wildcard /usr/lib/$(shell gcc -print-multiarch)/dri/swrast_dri.so) \
 	  ASAN_OPTIONS=detect_leaks=1:verify_asan_link_order=0 \
-	  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
+	  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/support/lsan.supp:print_suppressions=0 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j $(JOBS) -LE farm
 
 fuzz:

@@ -9,7 +9,7 @@ against `veil reference` single scattering.
 Scenes (240x320 pixels, one sun, isotropic phase, black background):
 - smoke: ../shared/data/smoke.vdb (skipped when absent);
 - sphere: a fog sphere made by OpenVDB's own vdb_tool (-sphere -ls2fog);
-- plume: the noise plume of tests/make_test_vdbs, faded out at its bottom
+- plume: the noise plume of tests/support/make_test_vdbs.cpp, faded out at its bottom
   and top (--plume-faded): cut through, its dense faces are a place where
   the two tools' media differ (docs/peers.md).
 

@@ -34,7 +34,7 @@
  * exp and erfc to the rounding of the exponent s^2 d^2 and of u0, u1, which
  * are O(s R) (so ~1e-13 at s R = 25, where the result is ~e^-625). Smaller
  * results may lose relative accuracy or flush to 0; never negative or NaN.
- * tests/test_reference.c measures at most 0.44 of this bound. */
+ * tests/reference/test_reference.c measures at most 0.44 of this bound. */
 double veil_gaussian_line_integral(const veil_particle* p, const double a[3], const double b[3]);
 
 /* Sum over n particles of veil_gaussian_line_integral (compensated sum). */

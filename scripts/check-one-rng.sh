@@ -8,7 +8,7 @@
 # constants may appear in core/rng.h only: the counter's increment
 # 0x9E3779B97F4A7C15 and the finaliser's first multiplier 0xBF58476D1CE4E5B9
 # (case-insensitive, with or without a ull suffix; a shader or script
-# counts too). tests/test_rbf.c pins the first output for seed 0 as a
+# counts too). tests/volume/test_rbf.c pins the first output for seed 0 as a
 # number, so it needs neither constant.
 set -u
 src=${1:?usage: check-one-rng.sh SOURCE_DIR}

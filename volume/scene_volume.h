@@ -10,7 +10,7 @@
  * then splats the particles on the GPU; the CPU reference
  * (veil_scene_volume_density) splats them with veil_inject_rbf_cpu. Both
  * resample the grids with veil_vdb_to_grid first, so the two see the same
- * volume (the splats agree to ~1e-6 relative, tests/test_inject_gpu.c).
+ * volume (the splats agree to ~1e-6 relative, tests/volume/test_inject_gpu.c).
  */
 #ifndef VEIL_SCENE_VOLUME_H
 #define VEIL_SCENE_VOLUME_H

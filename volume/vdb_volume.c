@@ -179,7 +179,7 @@ veil_result veil_vdb_plan_resample(const veil_vdb* v, const veil_grid* g, veil_v
     /* Reducing (target voxel larger than the VDB's): the box filter. Not reducing
      * (the same size under a rotation, or enlarging): the field at each target
      * centre, k = 1, the trilinear field itself (a box mean there would only
-     * blur; tests/test_vdb.c "filters" measures both). */
+     * blur; tests/volume/test_vdb_import.c "filters" measures both). */
     double want = (double)g->voxel <= h * (1.0 + VDB_K_ROUNDING)
                       ? 1.0
                       : ceil(VEIL_VDB_SAMPLES_PER_VOXEL * (double)g->voxel / h - VDB_K_ROUNDING);

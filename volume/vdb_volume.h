@@ -24,7 +24,7 @@
  * lattice is exactly m for any offset, so the mass is exact up to float
  * rounding; otherwise the error is an aliasing term (the field's spectrum
  * near the VDB lattice's frequencies, weighted by sinc^2 of the offset),
- * small for smooth fields and measured by tests/test_vdb.c.
+ * small for smooth fields and measured by tests/io/test_vdb.c.
  *
  * The samples interpolate the VDB's values read into a dense array over the
  * index box they reach (at most VEIL_VDB_MAX_DENSE_VOXELS, else

@@ -12,7 +12,7 @@
 // The mask. The paper writes smoothstep(T, (1 + eps) T, W) with T = c 2^(k-1):
 // read so, a pixel of spread W = c 2^j, which reads level j, enters level
 // j at smoothstep(W/2, 3W/2, W) = 1/2 and half of its light is lost (on a
-// constant-W image: 42 % RMSE against the gathering filter, tests/
+// constant-W image: 42 % RMSE against the gathering filter, tests/render/
 // test_spread.c). A pixel must be whole in every level it is read from
 // (j and j + 1 for a fractional level, one more for cubic interpolation)
 // and may fade from the levels above: so the ramp ends at T.
