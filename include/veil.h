@@ -26,6 +26,9 @@
  * that creates it; use it (and the images it renders) on that thread only,
  * one context per thread. Scenes and images hold no GL objects: once made
  * they can be read from any thread.
+ *
+ * ABI: libveil.so exports exactly the functions declared here and in
+ * veil/result.h, each marked VEIL_API; everything else is hidden.
  */
 #ifndef VEIL_H
 #define VEIL_H
@@ -40,7 +43,7 @@ extern "C" {
 #endif
 
 /* "0.1.0": the library's version. */
-const char* veil_version(void);
+VEIL_API const char* veil_version(void);
 
 /* ---- context: a GL context and the renderer's kept stage results ------ */
 
@@ -56,8 +59,8 @@ typedef struct veil_context_desc {
  * renderer on it (desc may be NULL). VEIL_ERR_GPU when no such context can
  * be made. A context keeps each stage's results between renders: rendering
  * a turntable of one scene injects and propagates once. */
-veil_result veil_context_create(const veil_context_desc* desc, veil_context** out, veil_error* err);
-void veil_context_destroy(veil_context* ctx); /* accepts NULL */
+VEIL_API veil_result veil_context_create(const veil_context_desc* desc, veil_context** out, veil_error* err);
+VEIL_API void veil_context_destroy(veil_context* ctx); /* accepts NULL */
 
 /* ---- scene ------------------------------------------------------------- */
 
@@ -66,8 +69,8 @@ typedef struct veil_scene veil_scene;
 /* Reads a scene file (relative paths inside resolve against its folder).
  * VEIL_ERR_IO, VEIL_ERR_PARSE or VEIL_ERR_INVALID with the file and the
  * JSON path of the offending field. */
-veil_result veil_scene_open(const char* path, veil_scene** out, veil_error* err);
-void veil_scene_close(veil_scene* scene); /* accepts NULL */
+VEIL_API veil_result veil_scene_open(const char* path, veil_scene** out, veil_error* err);
+VEIL_API void veil_scene_close(veil_scene* scene); /* accepts NULL */
 
 /* ---- render ------------------------------------------------------------ */
 
@@ -86,38 +89,38 @@ typedef struct veil_render_desc {
 
 /* Renders scene with ctx (desc may be NULL) into a new image (*out; free
  * it with veil_image_destroy). */
-veil_result veil_render(veil_context* ctx, const veil_scene* scene, const veil_render_desc* desc,
+VEIL_API veil_result veil_render(veil_context* ctx, const veil_scene* scene, const veil_render_desc* desc,
                         veil_image** out, veil_error* err);
 
 /* ---- image --------------------------------------------------------------- */
 
-void veil_image_size(const veil_image* img, int* width, int* height); /* 0x0 for NULL */
+VEIL_API void veil_image_size(const veil_image* img, int* width, int* height); /* 0x0 for NULL */
 
 /* width*height*4 floats: linear R, G, B and A, top row first; owned by img. */
-const float* veil_image_rgba(const veil_image* img);
+VEIL_API const float* veil_image_rgba(const veil_image* img);
 
 /* One channel as a width*height plane into out (the caller's). Names:
  * "R", "G", "B", "A", "T.R", "T.G", "T.B" (transmittance), "P" (density
  * integral), "single.R", "single.G", "single.B" (single scattering),
  * "depth" (mean distance of the first interaction, m). VEIL_ERR_INVALID
  * for any other name. */
-veil_result veil_image_channel(const veil_image* img, const char* name, float* out, veil_error* err);
+VEIL_API veil_result veil_image_channel(const veil_image* img, const char* name, float* out, veil_error* err);
 
 /* EXR, 32-bit float, ZIP: R, G, B, A, plus every other channel above when
  * aovs is non-zero. All or nothing: a failed write leaves no file. */
-veil_result veil_image_write_exr(const veil_image* img, const char* path, int aovs, veil_error* err);
+VEIL_API veil_result veil_image_write_exr(const veil_image* img, const char* path, int aovs, veil_error* err);
 
 /* 8-bit sRGB PNG preview of the radiance times 2^exposure, tone-mapped. */
-veil_result veil_image_write_png(const veil_image* img, const char* path, float exposure, veil_error* err);
+VEIL_API veil_result veil_image_write_png(const veil_image* img, const char* path, float exposure, veil_error* err);
 
 /* The render's stage reports ("inject", "propagate", "volumetric", "render", "spread"), in order:
  * what each did ("ran", "cached", "skipped"), its wall time (ms) and why.
  * Each output may be NULL; the strings are owned by img (names: static). */
-int veil_image_stage_count(const veil_image* img); /* 0 for NULL */
-veil_result veil_image_stage(const veil_image* img, int i, const char** name, const char** status, double* ms,
+VEIL_API int veil_image_stage_count(const veil_image* img); /* 0 for NULL */
+VEIL_API veil_result veil_image_stage(const veil_image* img, int i, const char** name, const char** status, double* ms,
                              const char** why);
 
-void veil_image_destroy(veil_image* img); /* accepts NULL */
+VEIL_API void veil_image_destroy(veil_image* img); /* accepts NULL */
 
 #ifdef __cplusplus
 }
