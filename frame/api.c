@@ -36,6 +36,13 @@ const char* veil_version(void)
     return VEIL_VERSION;
 }
 
+void veil_version_numbers(int* major, int* minor, int* patch)
+{
+    if (major) *major = VEIL_VERSION_MAJOR;
+    if (minor) *minor = VEIL_VERSION_MINOR;
+    if (patch) *patch = VEIL_VERSION_PATCH;
+}
+
 /* ---- context ------------------------------------------------------------- */
 
 veil_result veil_context_create(const veil_context_desc* desc, veil_context** out, veil_error* err)

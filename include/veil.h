@@ -28,7 +28,11 @@
  * they can be read from any thread.
  *
  * ABI: libveil.so exports exactly the functions declared here and in
- * veil/result.h, each marked VEIL_API; everything else is hidden.
+ * veil/result.h, each marked VEIL_API; everything else is hidden. The
+ * VEIL_VERSION_* macros are the version of this header; veil_version() and
+ * veil_version_numbers() that of the library actually loaded, so a caller
+ * can check one against the other. A minor version may add functions and
+ * description fields; the .so's soname names major.minor.
  */
 #ifndef VEIL_H
 #define VEIL_H
@@ -38,12 +42,21 @@
 
 #include "veil/result.h"
 
+/* This header's version (CMakeLists.txt reads the project's version from
+ * these three lines). */
+#define VEIL_VERSION_MAJOR 0
+#define VEIL_VERSION_MINOR 2
+#define VEIL_VERSION_PATCH 0
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* "0.1.0": the library's version. */
+/* The loaded library's version: "0.2.0". */
 VEIL_API const char* veil_version(void);
+
+/* The loaded library's version as numbers (each output may be NULL). */
+VEIL_API void veil_version_numbers(int* major, int* minor, int* patch);
 
 /* ---- context: a GL context and the renderer's kept stage results ------ */
 
