@@ -33,6 +33,18 @@
  * veil_version_numbers() that of the library actually loaded, so a caller
  * can check one against the other. A minor version may add functions and
  * description fields; the .so's soname names major.minor.
+ *
+ * Descriptions grow: each veil_X_desc opens with `size`, which the caller
+ * sets to sizeof(veil_X_desc) (VEIL_X_DESC_INIT does), and a later veil.h
+ * only appends fields. The library reads the fields that lie within `size`
+ * and takes the default for the rest, so a program built against an older
+ * veil.h keeps its meaning. size 0 (a description zeroed with `= {0}` or
+ * written with designated initializers that leave size out) means the
+ * first layout, veil 0.2's, every field of which is read. A size larger
+ * than the library's own layout (a program built against a newer veil.h
+ * running on an older library), or one that is no layout's size, is
+ * refused with VEIL_ERR_INVALID and a message naming both sizes; the
+ * library never reads past what the caller said it passed.
  */
 #ifndef VEIL_H
 #define VEIL_H
@@ -62,11 +74,18 @@ VEIL_API void veil_version_numbers(int* major, int* minor, int* patch);
 
 typedef struct veil_context veil_context;
 
-/* Zero means default in every field. */
+/* Zero means default in every field but size. */
 typedef struct veil_context_desc {
+    size_t size;        /* sizeof(veil_context_desc), or 0: veil 0.2's layout (see the top) */
     int force_software; /* 1: software rasteriser only; 0: hardware first (VEIL_DEVICE=software also forces it) */
     int debug;          /* 1: a GL debug context */
 } veil_context_desc;
+
+#ifdef __cplusplus
+#define VEIL_CONTEXT_DESC_INIT {sizeof(veil_context_desc), 0, 0}
+#else
+#define VEIL_CONTEXT_DESC_INIT {.size = sizeof(veil_context_desc)}
+#endif
 
 /* Creates a headless GL 4.5 context, current on the calling thread, and a
  * renderer on it (desc may be NULL). VEIL_ERR_GPU when no such context can
@@ -89,8 +108,9 @@ VEIL_API void veil_scene_close(veil_scene* scene); /* accepts NULL */
 
 typedef struct veil_image veil_image;
 
-/* Zero means default in every field. */
+/* Zero means default in every field but size. */
 typedef struct veil_render_desc {
+    size_t size;        /* sizeof(veil_render_desc), or 0: veil 0.2's layout (see the top) */
     int width, height;  /* pixels, 1..16384; 0: the scene camera's */
     float step_voxels;  /* ray-march step in voxels of the extinction volume; 0: 0.5 */
     uint32_t seed;      /* jitter seed: the same seed renders the same image */
@@ -99,6 +119,12 @@ typedef struct veil_render_desc {
                            `frames` equal steps (frame 0: the scene's camera);
                            0 or 1: the scene's camera (frame must be 0) */
 } veil_render_desc;
+
+#ifdef __cplusplus
+#define VEIL_RENDER_DESC_INIT {sizeof(veil_render_desc), 0, 0, 0.0f, 0u, 0L, 0L}
+#else
+#define VEIL_RENDER_DESC_INIT {.size = sizeof(veil_render_desc)}
+#endif
 
 /* Renders scene with ctx (desc may be NULL) into a new image (*out; free
  * it with veil_image_destroy). */
