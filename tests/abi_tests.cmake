@@ -1,9 +1,9 @@
 # The ABI is include/ (include/veil.h, "ABI" and "Descriptions grow").
 #   check_exports           libveil.so exports exactly what include/ declares
-#                           with VEIL_API (tests/check_exports.sh); it listed
-#                           7387 symbols, OpenVDB's template code and 256
-#                           internal functions among them, before hidden
-#                           visibility
+#                           with VEIL_API (tests/check_exports.sh); before
+#                           hidden visibility it listed 7387 symbols: veil's
+#                           internal functions and data, OpenVDB's template
+#                           code
 #   check_exports_selftest  that check fails on a header missing a
 #                           declaration, an unmarked declaration, and stray or
 #                           missing symbols
