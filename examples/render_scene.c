@@ -3,7 +3,8 @@
  *   render_scene SCENE.json OUT.exr [WIDTH HEIGHT]
  *
  * Prints each stage's report and the path written. Exit 0 on success, 1 on
- * an error (its message on stderr), 2 on bad arguments, 3 when no GL 4.5
+ * an error (its message on stderr) or when the loaded libveil.so is not
+ * the version <veil.h> describes, 2 on bad arguments, 3 when no GL 4.5
  * context can be made (a test can skip). */
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,7 +23,15 @@ int main(int argc, char** argv)
         fprintf(stderr, "usage: %s SCENE.json OUT.exr [WIDTH HEIGHT]\n", argv[0]);
         return 2;
     }
-    veil_render_desc desc = {0}; /* zero: the scene's size, default step, seed 0 */
+    int major, minor, patch;
+    veil_version_numbers(&major, &minor, &patch);
+    if (major != VEIL_VERSION_MAJOR || minor != VEIL_VERSION_MINOR) {
+        fprintf(stderr, "render_scene: built against veil %d.%d, running with %s\n", VEIL_VERSION_MAJOR,
+                VEIL_VERSION_MINOR, veil_version());
+        return 1;
+    }
+    /* the size set, every other field zero: the scene's size, default step, seed 0 */
+    veil_render_desc desc = VEIL_RENDER_DESC_INIT;
     if (argc == 5) {
         desc.width = atoi(argv[3]);
         desc.height = atoi(argv[4]);

@@ -16,6 +16,7 @@
 #include "../render/image_set.h"
 #include "../scene/camera.h"
 #include "../scene/scene.h"
+#include "desc_size.h"
 #include "renderer.h"
 #include "stage.h"
 
@@ -36,17 +37,59 @@ const char* veil_version(void)
     return VEIL_VERSION;
 }
 
+void veil_version_numbers(int* major, int* minor, int* patch)
+{
+    if (major) *major = VEIL_VERSION_MAJOR;
+    if (minor) *minor = VEIL_VERSION_MINOR;
+    if (patch) *patch = VEIL_VERSION_PATCH;
+}
+
+/* ---- the released layouts of each description ---------------------------
+ * Frozen copies, one per release that changed the struct, oldest first; a
+ * later veil.h only appends fields (include/veil.h, "Descriptions grow").
+ * When a field is added: freeze the new layout here (larger than the one
+ * before), append it to the list and point the _NEWEST name at it. */
+
+#define VEIL__COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
+
+typedef struct context_desc_0_2 {
+    size_t size;
+    int force_software, debug;
+} context_desc_0_2;
+#define CONTEXT_DESC_NEWEST context_desc_0_2
+static const veil__desc_layout context_desc_releases[] = {VEIL__DESC_LAYOUT(context_desc_0_2, debug)};
+static const veil__desc_layouts context_desc_layouts = {"veil_context_create", "veil_context_desc",
+                                                        context_desc_releases, VEIL__COUNT(context_desc_releases)};
+_Static_assert(sizeof(veil_context_desc) == sizeof(CONTEXT_DESC_NEWEST),
+               "veil_context_desc changed: freeze its new layout above");
+
+typedef struct render_desc_0_2 {
+    size_t size;
+    int width, height;
+    float step_voxels;
+    uint32_t seed;
+    long frame, frames;
+} render_desc_0_2;
+#define RENDER_DESC_NEWEST render_desc_0_2
+static const veil__desc_layout render_desc_releases[] = {VEIL__DESC_LAYOUT(render_desc_0_2, frames)};
+static const veil__desc_layouts render_desc_layouts = {"veil_render", "veil_render_desc", render_desc_releases,
+                                                       VEIL__COUNT(render_desc_releases)};
+_Static_assert(sizeof(veil_render_desc) == sizeof(RENDER_DESC_NEWEST),
+               "veil_render_desc changed: freeze its new layout above");
+
 /* ---- context ------------------------------------------------------------- */
 
 veil_result veil_context_create(const veil_context_desc* desc, veil_context** out, veil_error* err)
 {
     if (!out) return VEIL__NULL_ARG("veil_context_create", "out");
     *out = NULL;
-    veil_context_desc d = desc ? *desc : (veil_context_desc){0};
+    veil_context_desc d;
+    veil_result r = veil__desc_read(&context_desc_layouts, desc, &d, err);
+    if (r != VEIL_OK) return r;
     veil_context* ctx = calloc(1, sizeof *ctx);
     if (!ctx) return veil_fail(err, VEIL_ERR_OOM, "veil_context_create: out of memory");
     veil_gl_desc gd = {.force_software = d.force_software != 0, .debug = d.debug != 0};
-    veil_result r = veil_gl_create(&gd, &ctx->gl, err);
+    r = veil_gl_create(&gd, &ctx->gl, err);
     if (r == VEIL_OK) r = veil_renderer_create(ctx->gl, &ctx->renderer, err);
     if (r != VEIL_OK) {
         veil_context_destroy(ctx);
@@ -115,8 +158,9 @@ veil_result veil_render(veil_context* ctx, const veil_scene* scene, const veil_r
     *out = NULL;
     if (!ctx) return VEIL__NULL_ARG("veil_render", "ctx");
     if (!scene) return VEIL__NULL_ARG("veil_render", "scene");
-    veil_render_desc d = desc ? *desc : (veil_render_desc){0};
-    veil_result r = check_render_desc(&d, err);
+    veil_render_desc d;
+    veil_result r = veil__desc_read(&render_desc_layouts, desc, &d, err);
+    if (r == VEIL_OK) r = check_render_desc(&d, err);
     if (r != VEIL_OK) return r;
 
     veil_image* img = calloc(1, sizeof *img);

@@ -26,6 +26,25 @@
  * that creates it; use it (and the images it renders) on that thread only,
  * one context per thread. Scenes and images hold no GL objects: once made
  * they can be read from any thread.
+ *
+ * ABI: libveil.so exports exactly the functions declared here and in
+ * veil/result.h, each marked VEIL_API; everything else is hidden. The
+ * VEIL_VERSION_* macros are the version of this header; veil_version() and
+ * veil_version_numbers() that of the library actually loaded, so a caller
+ * can check one against the other. A minor version may add functions and
+ * description fields; the .so's soname names major.minor.
+ *
+ * Descriptions grow: each veil_X_desc opens with `size`, which the caller
+ * sets to sizeof(veil_X_desc) (VEIL_X_DESC_INIT does), and a later veil.h
+ * only appends fields. The library reads the fields that lie within `size`
+ * and takes the default for the rest, so a program built against an older
+ * veil.h keeps its meaning. size 0 (a description zeroed with `= {0}` or
+ * written with designated initializers that leave size out) means the
+ * first layout, veil 0.2's, every field of which is read. A size larger
+ * than the library's own layout (a program built against a newer veil.h
+ * running on an older library), or one that is no layout's size, is
+ * refused with VEIL_ERR_INVALID and a message naming both sizes; the
+ * library never reads past what the caller said it passed.
  */
 #ifndef VEIL_H
 #define VEIL_H
@@ -35,29 +54,45 @@
 
 #include "veil/result.h"
 
+/* This header's version (CMakeLists.txt reads the project's version from
+ * these three lines). */
+#define VEIL_VERSION_MAJOR 0
+#define VEIL_VERSION_MINOR 2
+#define VEIL_VERSION_PATCH 0
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* "0.1.0": the library's version. */
-const char* veil_version(void);
+/* The loaded library's version: "0.2.0". */
+VEIL_API const char* veil_version(void);
+
+/* The loaded library's version as numbers (each output may be NULL). */
+VEIL_API void veil_version_numbers(int* major, int* minor, int* patch);
 
 /* ---- context: a GL context and the renderer's kept stage results ------ */
 
 typedef struct veil_context veil_context;
 
-/* Zero means default in every field. */
+/* Zero means default in every field but size. */
 typedef struct veil_context_desc {
+    size_t size;        /* sizeof(veil_context_desc), or 0: veil 0.2's layout (see the top) */
     int force_software; /* 1: software rasteriser only; 0: hardware first (VEIL_DEVICE=software also forces it) */
     int debug;          /* 1: a GL debug context */
 } veil_context_desc;
+
+#ifdef __cplusplus
+#define VEIL_CONTEXT_DESC_INIT {sizeof(veil_context_desc), 0, 0}
+#else
+#define VEIL_CONTEXT_DESC_INIT {.size = sizeof(veil_context_desc)}
+#endif
 
 /* Creates a headless GL 4.5 context, current on the calling thread, and a
  * renderer on it (desc may be NULL). VEIL_ERR_GPU when no such context can
  * be made. A context keeps each stage's results between renders: rendering
  * a turntable of one scene injects and propagates once. */
-veil_result veil_context_create(const veil_context_desc* desc, veil_context** out, veil_error* err);
-void veil_context_destroy(veil_context* ctx); /* accepts NULL */
+VEIL_API veil_result veil_context_create(const veil_context_desc* desc, veil_context** out, veil_error* err);
+VEIL_API void veil_context_destroy(veil_context* ctx); /* accepts NULL */
 
 /* ---- scene ------------------------------------------------------------- */
 
@@ -66,15 +101,16 @@ typedef struct veil_scene veil_scene;
 /* Reads a scene file (relative paths inside resolve against its folder).
  * VEIL_ERR_IO, VEIL_ERR_PARSE or VEIL_ERR_INVALID with the file and the
  * JSON path of the offending field. */
-veil_result veil_scene_open(const char* path, veil_scene** out, veil_error* err);
-void veil_scene_close(veil_scene* scene); /* accepts NULL */
+VEIL_API veil_result veil_scene_open(const char* path, veil_scene** out, veil_error* err);
+VEIL_API void veil_scene_close(veil_scene* scene); /* accepts NULL */
 
 /* ---- render ------------------------------------------------------------ */
 
 typedef struct veil_image veil_image;
 
-/* Zero means default in every field. */
+/* Zero means default in every field but size. */
 typedef struct veil_render_desc {
+    size_t size;        /* sizeof(veil_render_desc), or 0: veil 0.2's layout (see the top) */
     int width, height;  /* pixels, 1..16384; 0: the scene camera's */
     float step_voxels;  /* ray-march step in voxels of the extinction volume; 0: 0.5 */
     uint32_t seed;      /* jitter seed: the same seed renders the same image */
@@ -84,40 +120,46 @@ typedef struct veil_render_desc {
                            0 or 1: the scene's camera (frame must be 0) */
 } veil_render_desc;
 
+#ifdef __cplusplus
+#define VEIL_RENDER_DESC_INIT {sizeof(veil_render_desc), 0, 0, 0.0f, 0u, 0L, 0L}
+#else
+#define VEIL_RENDER_DESC_INIT {.size = sizeof(veil_render_desc)}
+#endif
+
 /* Renders scene with ctx (desc may be NULL) into a new image (*out; free
  * it with veil_image_destroy). */
-veil_result veil_render(veil_context* ctx, const veil_scene* scene, const veil_render_desc* desc,
+VEIL_API veil_result veil_render(veil_context* ctx, const veil_scene* scene, const veil_render_desc* desc,
                         veil_image** out, veil_error* err);
 
 /* ---- image --------------------------------------------------------------- */
 
-void veil_image_size(const veil_image* img, int* width, int* height); /* 0x0 for NULL */
+VEIL_API void veil_image_size(const veil_image* img, int* width, int* height); /* 0x0 for NULL */
 
 /* width*height*4 floats: linear R, G, B and A, top row first; owned by img. */
-const float* veil_image_rgba(const veil_image* img);
+VEIL_API const float* veil_image_rgba(const veil_image* img);
 
 /* One channel as a width*height plane into out (the caller's). Names:
  * "R", "G", "B", "A", "T.R", "T.G", "T.B" (transmittance), "P" (density
  * integral), "single.R", "single.G", "single.B" (single scattering),
  * "depth" (mean distance of the first interaction, m). VEIL_ERR_INVALID
  * for any other name. */
-veil_result veil_image_channel(const veil_image* img, const char* name, float* out, veil_error* err);
+VEIL_API veil_result veil_image_channel(const veil_image* img, const char* name, float* out, veil_error* err);
 
 /* EXR, 32-bit float, ZIP: R, G, B, A, plus every other channel above when
  * aovs is non-zero. All or nothing: a failed write leaves no file. */
-veil_result veil_image_write_exr(const veil_image* img, const char* path, int aovs, veil_error* err);
+VEIL_API veil_result veil_image_write_exr(const veil_image* img, const char* path, int aovs, veil_error* err);
 
 /* 8-bit sRGB PNG preview of the radiance times 2^exposure, tone-mapped. */
-veil_result veil_image_write_png(const veil_image* img, const char* path, float exposure, veil_error* err);
+VEIL_API veil_result veil_image_write_png(const veil_image* img, const char* path, float exposure, veil_error* err);
 
 /* The render's stage reports ("inject", "propagate", "volumetric", "render", "spread"), in order:
  * what each did ("ran", "cached", "skipped"), its wall time (ms) and why.
  * Each output may be NULL; the strings are owned by img (names: static). */
-int veil_image_stage_count(const veil_image* img); /* 0 for NULL */
-veil_result veil_image_stage(const veil_image* img, int i, const char** name, const char** status, double* ms,
+VEIL_API int veil_image_stage_count(const veil_image* img); /* 0 for NULL */
+VEIL_API veil_result veil_image_stage(const veil_image* img, int i, const char** name, const char** status, double* ms,
                              const char** why);
 
-void veil_image_destroy(veil_image* img); /* accepts NULL */
+VEIL_API void veil_image_destroy(veil_image* img); /* accepts NULL */
 
 #ifdef __cplusplus
 }

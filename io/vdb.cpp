@@ -5,8 +5,20 @@
 // C++ crosses the header. Files are opened without delayed loading, so the
 // grid is read completely (and a truncated file fails) inside veil_vdb_open,
 // never later from a memory-mapped file.
+//
+// Visibility: veil's own declarations are hidden (libveil.so exports only
+// include/'s VEIL_API functions), OpenVDB's are not. The objects are C++
+// without -fvisibility=hidden: with it the template code instantiated here
+// was hidden, and openvdb::initialize() crashed registering its grid types
+// in a program linking libveil.a. The pragma below covers only veil's
+// headers; the system headers they use come first, at default visibility.
+#include <stddef.h>
+#include <stdint.h>
+#include <string>
+#pragma GCC visibility push(hidden)
 #include "vdb.h"
 #include "vdb_header.hpp"
+#pragma GCC visibility pop
 
 #include <openvdb/openvdb.h>
 #include <openvdb/io/File.h>

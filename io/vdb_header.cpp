@@ -1,6 +1,9 @@
 // veil — an OpenVDB file's own claims, checked before OpenVDB reads it
 // (io/vdb_header.hpp).
+#include <string>
+#pragma GCC visibility push(hidden) // veil's own, not part of libveil.so's ABI (io/vdb.cpp says why a pragma)
 #include "vdb_header.hpp"
+#pragma GCC visibility pop
 
 #include <algorithm>
 #include <cstdint>

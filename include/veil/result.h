@@ -7,12 +7,24 @@
  *
  * The table below is the one place the codes are defined: it yields the enum,
  * the name (veil_result_name) and a generic message (veil_result_message).
+ *
+ * VEIL_API, defined here because every public header includes this one,
+ * marks each function libveil.so exports: the library is compiled with
+ * hidden visibility, so a function without it is not part of the ABI.
  */
 #ifndef VEIL_PUBLIC_RESULT_H
 #define VEIL_PUBLIC_RESULT_H
 
 #include <stddef.h>
 #include <stdint.h>
+
+#ifndef VEIL_API
+#if defined(__GNUC__) || defined(__clang__)
+#define VEIL_API __attribute__((visibility("default")))
+#else
+#define VEIL_API
+#endif
+#endif
 
 #ifdef __cplusplus
 extern "C" {
@@ -43,8 +55,8 @@ typedef struct veil_error {
     char msg[VEIL_ERROR_MAX];
 } veil_error;
 
-const char* veil_result_name(veil_result r);    /* "VEIL_ERR_IO" */
-const char* veil_result_message(veil_result r); /* generic text */
+VEIL_API const char* veil_result_name(veil_result r);    /* "VEIL_ERR_IO" */
+VEIL_API const char* veil_result_message(veil_result r); /* generic text */
 
 #ifdef __cplusplus
 }
