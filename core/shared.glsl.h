@@ -120,7 +120,7 @@
 #define VEIL_TEX_SUN0 9
 
 /* A light as the GPU sees it: one shape for every shader (std140, 48 bytes).
- * Filled from scene/scene.h's veil_light by veil_gpu_light_from(). */
+ * Filled from scene/light.h's veil_light by veil_light_to_gpu(). */
 VEIL_STRUCT_BEGIN(veil_gpu_light)
     VEIL_V4(position);  /* xyz: point, spot position (m); w: type, VEIL_LIGHT_* */
     VEIL_V4(direction); /* xyz: directional: unit travel direction; spot: its axis; w: spot cos(inner angle),

@@ -25,7 +25,7 @@ static GLint loc(GLuint prog, const char* name) { return glGetUniformLocation(pr
 
 /* ---- Jacobi ------------------------------------------------------------ */
 
-static void jacobi_lights(GLuint prog, const veil_opv_light* lights, int count)
+static void jacobi_lights(GLuint prog, const veil_index_light* lights, int count)
 {
     GLint types[4] = {0, 0, 0, 0}, cells[12] = {0};
     GLfloat v[12] = {0};
@@ -78,7 +78,7 @@ static void jacobi_texture(GLuint prog, const veil_grid* g, GLuint target, GLuin
     *iterations = it;
 }
 
-static veil_result run_jacobi(GLuint prog, const veil_grid* g, const veil_opv_light* lights, int n_lights,
+static veil_result run_jacobi(GLuint prog, const veil_grid* g, const veil_index_light* lights, int n_lights,
                               const veil_opv_params* params, const GLuint* opv, int* iterations, veil_error* err)
 {
     int max_it = params->max_iterations > 0 ? params->max_iterations : veil_opv_exact_iterations(g);
@@ -125,7 +125,7 @@ static void dispatch_boxes(GLuint prog, int mode, const veil__box* boxes, int co
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
 }
 
-static int sweep_light(GLuint prog, const veil_grid* g, const veil_opv_light* L, veil_opv_method method)
+static int sweep_light(GLuint prog, const veil_grid* g, const veil_index_light* L, veil_opv_method method)
 {
     glProgramUniform1i(prog, loc(prog, "u_type"), L->type);
     glProgramUniform3fv(prog, loc(prog, "u_light"), 1, L->v);
@@ -170,7 +170,7 @@ static int sweep_light(GLuint prog, const veil_grid* g, const veil_opv_light* L,
     return passes;
 }
 
-veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, const veil_opv_light* lights,
+veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, const veil_index_light* lights,
                          int n_lights, const veil_opv_params* params, const GLuint* opv, int* iterations,
                          veil_error* err)
 {

@@ -22,7 +22,7 @@ void veil_opv_programs_destroy(veil_opv_programs* p);
  * by the caller; for the ordered methods a texture of one light may be
  * r32f) for lights 4t..4t+3; ev is the r32f density texture.
  * *iterations: the most Jacobi steps, or sweep passes, any light needed. */
-veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, const veil_opv_light* lights,
+veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, const veil_index_light* lights,
                          int n_lights, const veil_opv_params* params, const GLuint* opv, int* iterations,
                          veil_error* err);
 

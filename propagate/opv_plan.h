@@ -14,12 +14,12 @@ typedef struct veil__gather_plan {
     int solve;       /* axis solved for */
 } veil__gather_plan;
 
-void veil__gather_plan_make(const veil_grid* g, const veil_opv_light* l, veil__gather_plan* p);
+void veil__gather_plan_make(const veil_grid* g, const veil_index_light* l, veil__gather_plan* p);
 /* Up-wind distance of voxel x along axis a (directional: from the light-facing face). */
-int veil__gather_dist(const veil_grid* g, const veil_opv_light* l, int a, int x);
+int veil__gather_dist(const veil_grid* g, const veil_index_light* l, int a, int x);
 /* The coordinate(s) on `solve` of the shell-m voxels with the other two
  * coordinates given in x (x[solve] ignored); returns how many (0..2). */
-int veil__gather_solve(const veil_grid* g, const veil_opv_light* l, const veil__gather_plan* p, int m,
+int veil__gather_solve(const veil_grid* g, const veil_index_light* l, const veil__gather_plan* p, int m,
                        const int x[3], int out[2]);
 
 /* Semi-Lagrangian, point light: shell s = the voxels with integer
@@ -46,14 +46,14 @@ typedef struct veil__box {
 } veil__box;
 
 /* Shells s0..s1 (s0 >= 2) that meet the grid. */
-void veil__sl_shell_range(const veil_grid* g, const veil_opv_light* l, int* s0, int* s1);
+void veil__sl_shell_range(const veil_grid* g, const veil_index_light* l, int* s0, int* s1);
 /* The non-empty boxes of sub-pass k (1..3) of shell s; returns the count. */
-int veil__sl_boxes(const veil_grid* g, const veil_opv_light* l, int s, int k, veil__box out[VEIL_SL_MAX_BOXES]);
+int veil__sl_boxes(const veil_grid* g, const veil_index_light* l, int s, int k, veil__box out[VEIL_SL_MAX_BOXES]);
 /* The near field (shells 0 and 1), clipped; returns 0 when empty. */
-int veil__sl_near_box(const veil_grid* g, const veil_opv_light* l, veil__box* out);
+int veil__sl_near_box(const veil_grid* g, const veil_index_light* l, veil__box* out);
 /* Sun: slices along the dominant axis, from the light-facing side. */
-int veil__sl_sun_axis(const veil_opv_light* l);
+int veil__sl_sun_axis(const veil_index_light* l);
 /* The box of slice k (0 = the light-facing side). */
-void veil__sl_sun_slice(const veil_grid* g, const veil_opv_light* l, int k, veil__box* out);
+void veil__sl_sun_slice(const veil_grid* g, const veil_index_light* l, int k, veil__box* out);
 
 #endif

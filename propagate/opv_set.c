@@ -81,7 +81,7 @@ static uint64_t params_key(uint64_t key, const veil_opv_params* params)
     return veil_hash_bytes(key, &p, sizeof p);
 }
 
-uint64_t veil_opv_texture_key(uint64_t ev_key, const veil_opv_params* params, const veil_opv_light* lights, int count)
+uint64_t veil_opv_texture_key(uint64_t ev_key, const veil_opv_params* params, const veil_index_light* lights, int count)
 {
     uint64_t key = params_key(ev_key, params);
     for (int c = 0; c < count; ++c) key = veil_hash_bytes(key, &lights[c], sizeof lights[c]);
@@ -112,7 +112,7 @@ static veil_result texture_of(veil_opv_set* s, int t, const int dims[3], GLenum 
  * distance sum |b_a - c_a| (crossing a face towards it takes 1 off; where
  * b_a = c_a the path stays in that slab), from 0 up. So the lowest value
  * goes first either way. */
-static long long level_of(const veil_opv_light* l, const int32_t* b, int sun_sign[3], const int c[3])
+static long long level_of(const veil_index_light* l, const int32_t* b, int sun_sign[3], const int c[3])
 {
     long long v = 0;
     for (int a = 0; a < 3; ++a)
@@ -124,7 +124,7 @@ static long long level_of(const veil_opv_light* l, const int32_t* b, int sun_sig
  * propagate/shaders/propagate_sparse.comp over the kept bricks, level by
  * level (each pass reads only bricks of earlier passes). *passes: the most
  * passes of any light. */
-static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, const veil_opv_light* ol, int count,
+static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, const veil_index_light* ol, int count,
                                  GLuint tex, int* passes, veil_error* err)
 {
     veil_result r = VEIL_OK;
@@ -255,11 +255,11 @@ static veil_result sun_depths(veil_opv_set* s, const veil_grid* g, GLuint ev, GL
 }
 
 int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* lights, int n,
-                       const veil_opv_params* params, int max_axis, veil_opv_light* ol, veil_opv_sun* want,
+                       const veil_opv_params* params, int max_axis, veil_index_light* ol, veil_opv_sun* want,
                        uint64_t* want_key)
 {
     int count = 0;
-    for (int l = 0; l < n; ++l) veil_opv_light_from_world(g, &lights[l], &ol[l]);
+    for (int l = 0; l < n; ++l) veil_light_to_index(&lights[l], g->dims, g->origin, g->voxel, &ol[l]);
     if (veil_opv_method_resolve(params->method) != VEIL_OPV_LIGHT_SPACE) return 0;
     int suns = 0; /* the memory allowed is shared by the suns that may get a grid */
     for (int l = 0; l < n && suns < VEIL_MAX_SUNS; ++l) suns += lights[l].type == VEIL_LIGHT_DIRECTIONAL;
@@ -343,7 +343,7 @@ veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, 
     memset(rep, 0, sizeof *rep);
     veil_result r = VEIL_OK;
     const int report = veil_progress_wanted();
-    veil_opv_light ol[VEIL_MAX_LIGHTS];
+    veil_index_light ol[VEIL_MAX_LIGHTS];
     n = n < VEIL_MAX_LIGHTS ? n : VEIL_MAX_LIGHTS;
     veil_opv_sun want[VEIL_MAX_SUNS];
     uint64_t want_key[VEIL_MAX_SUNS];
@@ -399,7 +399,7 @@ veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, 
 }
 
 veil_result veil_opv_set_propagate_readback(veil_opv_set* s, const veil_grid* g, const float* density,
-                                            const veil_opv_light* lights, int n_lights,
+                                            const veil_index_light* lights, int n_lights,
                                             const veil_opv_params* params, float* out, int* iterations,
                                             veil_error* err)
 {

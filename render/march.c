@@ -8,6 +8,7 @@
 #include "../gpu/gl_util.h"
 #include "../gpu/programs.h"
 #include "../scene/camera.h"
+#include "../scene/light.h"
 
 struct veil_march {
     GLuint program, program_emission, ubo; /* the march, and its variant with emission */
@@ -47,14 +48,6 @@ void veil_march_destroy(veil_march* m)
 static void set3(float dst[4], const float src[3], float w)
 {
     dst[0] = src[0], dst[1] = src[1], dst[2] = src[2], dst[3] = w;
-}
-
-void veil_gpu_light_from(const veil_light* l, veil_gpu_light* out)
-{
-    set3(out->position, l->position, (float)l->type);
-    set3(out->direction, l->direction,
-         l->type == VEIL_LIGHT_POINT ? l->radius * l->radius : cosf(l->inner_angle_deg * (float)(VEIL_PI / 180.0)));
-    set3(out->color, l->color, cosf(l->outer_angle_deg * (float)(VEIL_PI / 180.0)));
 }
 
 veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u, veil_error* err)
@@ -102,7 +95,7 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
         set3(f->box_max, src->fog.bounds[1], 0.0f);
     }
     int n = d->light_count < VEIL_MAX_LIGHTS ? d->light_count : VEIL_MAX_LIGHTS;
-    for (int l = 0; l < n; ++l) veil_gpu_light_from(&d->lights[l], &u->lights[l]);
+    for (int l = 0; l < n; ++l) veil_light_to_gpu(&d->lights[l], &u->lights[l]);
     u->size[0] = d->width, u->size[1] = d->height, u->size[2] = n, u->size[3] = fogs;
     u->flags[0] = d->grid != NULL;
     /* empty bricks hold no density but may glow: no skipping with emission (a sparse volume's bricks

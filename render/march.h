@@ -93,7 +93,4 @@ void veil_march_set_dispatch_work(uint64_t work);
  * that reads render/shaders/medium_common.glsl; 0 unbinds them. */
 void veil_march_bind_depths(const veil_march_desc* d);
 
-/* One light in the GPU's shape. */
-void veil_gpu_light_from(const veil_light* l, veil_gpu_light* out);
-
 #endif
