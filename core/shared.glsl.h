@@ -107,6 +107,7 @@
 #define VEIL_IMAGE_AOV_V 6      /* image unit: rgba32f march AOV: volumetric multiple scattering rgb */
 #define VEIL_IMAGE_AOV_Q 7      /* image unit: rgba32f march AOV: single scattering's out-scattered rgb, its P */
 #define VEIL_UBO_MARCH 0        /* uniform block: veil_march_block */
+#define VEIL_UBO_PROPAGATE 4    /* uniform block: the optical-depth pass's own (propagate/opv_blocks.glsl.h) */
 #define VEIL_TEX_EV 0           /* texture unit: sampled EV */
 #define VEIL_TEX_OPV0 1         /* texture units 1..4: sampled OPVs */
 #define VEIL_TEX_OCC 5          /* texture unit: occupancy bricks (max density per brick) */

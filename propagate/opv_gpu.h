@@ -2,17 +2,20 @@
  * (propagate/shaders/propagate_jacobi.comp, four lights per step) and the
  * ordered one-pass methods (propagate/shaders/propagate_sweep.comp, one
  * light at a time, in place). Same per-voxel code and order as
- * veil_opv_cpu(). */
+ * veil_opv_cpu(). Each pass reads its settings from a std140 block
+ * (opv_blocks.glsl.h) bound at VEIL_UBO_PROPAGATE while it runs. */
 #ifndef VEIL_OPV_GPU_H
 #define VEIL_OPV_GPU_H
 
 #include <epoxy/gl.h>
 
 #include "opv.h"
+#include "opv_blocks.glsl.h"
 
 typedef struct veil_opv_programs {
     GLuint jacobi, sweep;
     GLuint sweep_one; /* the sweep on an r32f texture of one light, made when first needed */
+    GLuint jacobi_block, sweep_block; /* their uniform buffers: veil_jacobi_block, veil_sweep_block */
 } veil_opv_programs;
 
 veil_result veil_opv_programs_create(veil_opv_programs* p, veil_error* err);

@@ -5,6 +5,7 @@
 #define VEIL_OPV_PLAN_H
 
 #include "opv.h"
+#include "opv_blocks.glsl.h"
 
 /* Gather sweep: pass m computes the voxels at up-wind Manhattan distance m.
  * Each pass enumerates the two axes other than `solve` over the grid and
@@ -39,7 +40,7 @@ int veil__gather_solve(const veil_grid* g, const veil_index_light* l, const veil
  * |Q_b - S_b| = |e_b| (1 - k/|e_a|) <= |e_a| - k, so the voxels read have
  * distance at most s - k + 1 < s on every axis: all in earlier shells (a
  * path that ends within k voxels is integrated without reading any). */
-#define VEIL_SL_MAX_BOXES 12 /* edges of a cube: the most boxes of a sub-pass */
+/* VEIL_SL_MAX_BOXES (opv_blocks.glsl.h): the edges of a cube, the most boxes of a sub-pass. */
 
 typedef struct veil__box {
     int lo[3], n[3]; /* voxels lo .. lo + n - 1, clipped to the grid */

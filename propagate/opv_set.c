@@ -1,6 +1,7 @@
 #include "opv_set.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -8,12 +9,14 @@
 #include "../core/progress.h"
 #include "../gpu/gl_util.h"
 #include "../gpu/programs.h"
+#include "opv_blocks.glsl.h"
 #include "opv_gpu.h"
 
 struct veil_opv_set {
     veil_opv_programs programs;
     GLuint sparse_program; /* propagate/shaders/propagate_sparse.comp, made when first needed */
     GLuint sun_program;    /* propagate/shaders/sun_prefix.comp, made when first needed */
+    GLuint sparse_block, sun_block; /* their uniform buffers (veil_sparse_od_block, veil_sun_block), made with them */
     GLuint tex[VEIL_MAX_OPV_TEXTURES];
     int dims[VEIL_MAX_OPV_TEXTURES][3];
     GLenum format[VEIL_MAX_OPV_TEXTURES]; /* rgba32f, or r32f for one light on the grid (ordered methods) */
@@ -60,6 +63,8 @@ void veil_opv_set_destroy(veil_opv_set* s)
     veil_opv_set_clear(s);
     glDeleteProgram(s->sparse_program);
     glDeleteProgram(s->sun_program);
+    glDeleteBuffers(1, &s->sparse_block);
+    glDeleteBuffers(1, &s->sun_block);
     veil_opv_programs_destroy(&s->programs);
     free(s);
 }
@@ -128,7 +133,11 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
                                  GLuint tex, int* passes, veil_error* err)
 {
     veil_result r = VEIL_OK;
-    if (!s->sparse_program) r = veil_gpu_program("propagate/shaders/propagate_sparse.comp", &s->sparse_program, err);
+    if (!s->sparse_block)
+        r = veil_gl_buffer(NULL, sizeof(veil_sparse_od_block), GL_DYNAMIC_STORAGE_BIT, "veil sparse optical depth block",
+                           &s->sparse_block, err);
+    if (r == VEIL_OK && !s->sparse_program)
+        r = veil_gpu_program("propagate/shaders/propagate_sparse.comp", &s->sparse_program, err);
     if (r != VEIL_OK) return r;
     size_t n = sp->slots;
     long long* level = malloc((n ? n : 1) * sizeof *level);
@@ -142,7 +151,9 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
     *passes = 0;
     for (int c = 0; c < count && r == VEIL_OK && n > 0; ++c) {
         /* the light in the sparse index space (opv.h's has voxel i's centre at i, this one at i + 0.5) */
-        float light[4];
+        veil_sparse_od_block blk;
+        memset(&blk, 0, sizeof blk);
+        float* light = blk.light;
         int sign[3], cb[3];
         for (int a = 0; a < 3; ++a) {
             light[a] = ol[c].v[a] + (ol[c].type == VEIL_LIGHT_DIRECTIONAL ? 0.0f : 0.5f);
@@ -151,6 +162,7 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
             cb[a] = cell < -1e9 ? -1000000000 : cell > 1e9 ? 1000000000 : (int)cell;
         }
         light[3] = (float)ol[c].type;
+        blk.pass[0] = c;
         /* counting sort of the slots by level */
         long long lo = 0, hi = 0;
         for (size_t i = 0; i < n; ++i) {
@@ -185,8 +197,8 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
         glCreateTextures(GL_TEXTURE_BUFFER, 1, &list_tex);
         glTextureBuffer(list_tex, GL_R32I, buf);
         glUseProgram(p);
-        glProgramUniform4fv(p, glGetUniformLocation(p, "u_light"), 1, light);
-        glProgramUniform1i(p, glGetUniformLocation(p, "u_channel"), c);
+        glNamedBufferSubData(s->sparse_block, 0, sizeof blk, &blk);
+        glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, s->sparse_block);
         veil_ev_sparse_bind(sp);
         glBindTextureUnit(VEIL_TEX_EV, sp->atlas);
         glBindTextureUnit(VEIL_TEX_SPARSE_LIST, list_tex);
@@ -196,9 +208,10 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
         for (size_t k = 0; k < levels; ++k) { /* rank 0, the bricks nearest the light, first */
             size_t m = first[k + 1] - first[k];
             if (!m) continue;
-            glProgramUniform1i(p, glGetUniformLocation(p, "u_first"), (GLint)first[k]);
             for (size_t g = 0; g < m; g += 65535) { /* GL's guaranteed work groups per dispatch */
-                if (g) glProgramUniform1i(p, glGetUniformLocation(p, "u_first"), (GLint)(first[k] + g));
+                blk.pass[1] = (int32_t)(first[k] + g);
+                glNamedBufferSubData(s->sparse_block, (GLintptr)offsetof(veil_sparse_od_block, pass),
+                                     sizeof blk.pass, blk.pass);
                 glDispatchCompute((GLuint)(m - g < 65535 ? m - g : 65535), 1, 1);
             }
             glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
@@ -209,6 +222,7 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
         glBindTextureUnit(VEIL_TEX_OPV0, 0);
         glBindTextureUnit(VEIL_TEX_SPARSE_LIST, 0);
         glBindTextureUnit(VEIL_TEX_EV, 0);
+        glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, 0);
         veil_ev_sparse_bind(NULL);
         glUseProgram(0);
         r = veil_gl_check("optical depth over a sparse volume (propagate/shaders/propagate_sparse.comp)", err);
@@ -228,20 +242,26 @@ static veil_result sun_depths(veil_opv_set* s, const veil_grid* g, GLuint ev, GL
                               GLuint tex, veil_error* err)
 {
     veil_result r = VEIL_OK;
-    if (!s->sun_program) r = veil_gpu_program("propagate/shaders/sun_prefix.comp", &s->sun_program, err);
+    if (!s->sun_block)
+        r = veil_gl_buffer(NULL, sizeof(veil_sun_block), GL_DYNAMIC_STORAGE_BIT, "veil light-space block",
+                           &s->sun_block, err);
+    if (r == VEIL_OK && !s->sun_program) r = veil_gpu_program("propagate/shaders/sun_prefix.comp", &s->sun_program, err);
     if (r != VEIL_OK) return r;
-    GLuint p = s->sun_program;
     const float* c = sp->axis[2];
-    glProgramUniform3i(p, glGetUniformLocation(p, "u_dims"), g->dims[0], g->dims[1], g->dims[2]);
-    glProgramUniform3i(p, glGetUniformLocation(p, "u_nodes"), sp->nodes[0], sp->nodes[1], sp->nodes[2]);
-    glProgramUniform3fv(p, glGetUniformLocation(p, "u_origin"), 1, sp->origin);
-    glProgramUniform3fv(p, glGetUniformLocation(p, "u_axis_a"), 1, sp->axis[0]);
-    glProgramUniform3fv(p, glGetUniformLocation(p, "u_axis_b"), 1, sp->axis[1]);
-    glProgramUniform3fv(p, glGetUniformLocation(p, "u_axis_c"), 1, sp->axis[2]);
-    glProgramUniform1i(p, glGetUniformLocation(p, "u_panels"), sp->panels);
-    glProgramUniform1f(p, glGetUniformLocation(p, "u_step"), sqrtf(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) * g->voxel);
-    glProgramUniform1i(p, glGetUniformLocation(p, "u_skip"), occ != 0);
-    glUseProgram(p);
+    veil_sun_block blk;
+    memset(&blk, 0, sizeof blk);
+    for (int a = 0; a < 3; ++a) {
+        blk.dims[a] = g->dims[a];
+        blk.nodes[a] = sp->nodes[a];
+        blk.origin[a] = sp->origin[a];
+        for (int k = 0; k < 3; ++k) blk.axis[k][a] = sp->axis[k][a];
+    }
+    blk.dims[3] = sp->panels;
+    blk.nodes[3] = occ != 0;
+    blk.origin[3] = sqrtf(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) * g->voxel; /* m a step along c */
+    glNamedBufferSubData(s->sun_block, 0, sizeof blk, &blk);
+    glUseProgram(s->sun_program);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, s->sun_block);
     glBindTextureUnit(VEIL_TEX_EV, ev);
     glBindTextureUnit(VEIL_TEX_OCC, occ);
     glBindImageTexture(VEIL_IMAGE_OPV_DST, tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
@@ -250,6 +270,7 @@ static veil_result sun_depths(veil_opv_set* s, const veil_grid* g, GLuint ev, GL
     glBindImageTexture(VEIL_IMAGE_OPV_DST, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
     glBindTextureUnit(VEIL_TEX_EV, 0);
     glBindTextureUnit(VEIL_TEX_OCC, 0);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, 0);
     glUseProgram(0);
     return veil_gl_check("a sun's light-space optical depth (propagate/shaders/sun_prefix.comp)", err);
 }
