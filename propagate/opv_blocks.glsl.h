@@ -3,10 +3,12 @@
  * (opv_gpu.c, opv_set.c) and the shaders that read them (each pulls this
  * file in with //@include). Every pass binds its block at
  * VEIL_UBO_PROPAGATE (core/shared.glsl.h) for its dispatches only, from a
- * buffer its owner keeps (veil_opv_programs, veil_opv_set).
+ * buffer its owner keeps (veil_opv_programs, veil_opv_set); passes that
+ * follow one another (a sweep's shells, a sparse volume's levels) have a
+ * block each in one buffer (gpu/pass_run.h).
  *
  * Only 16-byte members, so C and GLSL lay them out alike; the C side
- * checks each block's size and the offsets it uploads on their own below.
+ * checks each block's size and offsets below.
  * Index coordinates as in propagate/opv.h (voxel i's centre at i) unless a
  * block says otherwise; D in density m.
  */
@@ -40,9 +42,8 @@ VEIL_STRUCT_BEGIN(veil_sweep_box)
     VEIL_IV4(n);  /* xyz: voxels per axis; w: - */
 VEIL_STRUCT_END(veil_sweep_box)
 
-/* One pass of an ordered method (propagate_sweep.comp) for one light. What
- * changes from pass to pass (`pass` and the boxes) comes last, so a pass
- * uploads one range: from `pass` to the end of its last box. */
+/* One pass of an ordered method (propagate_sweep.comp) for one light:
+ * each pass of a light has its own copy, in one buffer (gpu/pass_run.h). */
 VEIL_STRUCT_BEGIN(veil_sweep_block)
     VEIL_IV4(dims);   /* xyz: the EV's voxels; w: the channel written, 0..3 */
     VEIL_V4(params);  /* x: voxel edge (m); y: exit steps (veil_opv_exit_steps); zw: - */
@@ -54,8 +55,8 @@ VEIL_STRUCT_BEGIN(veil_sweep_block)
     veil_sweep_box boxes[VEIL_SL_MAX_BOXES]; /* modes 1 and 2: work group z takes box z */
 VEIL_STRUCT_END(veil_sweep_block)
 
-/* One pass over a sparse volume (propagate_sparse.comp): one light, the
- * bricks of one level. Sparse index coordinates: voxel i's centre at i + 0.5
+/* One dispatch over a sparse volume (propagate_sparse.comp): one light, the
+ * bricks of one level (at most 65535 of them). Sparse index coordinates: voxel i's centre at i + 0.5
  * (volume/shaders/sparse_common.glsl). */
 VEIL_STRUCT_BEGIN(veil_sparse_od_block)
     VEIL_V4(light); /* xyz: a point light's position, or a sun's unit vector toward it; w: its type */

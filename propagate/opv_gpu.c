@@ -1,6 +1,5 @@
 #include "opv_gpu.h"
 
-#include <stddef.h>
 #include <string.h>
 
 #include "../gpu/gl_util.h"
@@ -9,15 +8,13 @@
 
 veil_result veil_opv_programs_create(veil_opv_programs* p, veil_error* err)
 {
-    p->jacobi = p->sweep = p->sweep_one = p->jacobi_block = p->sweep_block = 0;
+    p->jacobi = p->sweep = p->sweep_one = p->jacobi_block = 0;
+    veil_pass_run_init(&p->sweep_run, sizeof(veil_sweep_block), "veil sweep blocks");
     veil_result r = veil_gpu_program("propagate/shaders/propagate_jacobi.comp", &p->jacobi, err);
     if (r == VEIL_OK) r = veil_gpu_program("propagate/shaders/propagate_sweep.comp", &p->sweep, err);
     if (r == VEIL_OK)
         r = veil_gl_buffer(NULL, sizeof(veil_jacobi_block), GL_DYNAMIC_STORAGE_BIT, "veil Jacobi block",
                            &p->jacobi_block, err);
-    if (r == VEIL_OK)
-        r = veil_gl_buffer(NULL, sizeof(veil_sweep_block), GL_DYNAMIC_STORAGE_BIT, "veil sweep block",
-                           &p->sweep_block, err);
     if (r != VEIL_OK) veil_opv_programs_destroy(p);
     return r;
 }
@@ -28,8 +25,8 @@ void veil_opv_programs_destroy(veil_opv_programs* p)
     glDeleteProgram(p->sweep);
     glDeleteProgram(p->sweep_one);
     glDeleteBuffers(1, &p->jacobi_block);
-    glDeleteBuffers(1, &p->sweep_block);
-    p->jacobi = p->sweep = p->sweep_one = p->jacobi_block = p->sweep_block = 0;
+    veil_pass_run_free(&p->sweep_run);
+    p->jacobi = p->sweep = p->sweep_one = p->jacobi_block = 0;
 }
 
 /* ---- Jacobi ------------------------------------------------------------ */
@@ -118,84 +115,76 @@ static veil_result run_jacobi(veil_opv_programs* p, const veil_grid* g, const ve
 
 /* ---- ordered one-pass methods ------------------------------------------ */
 
-/* Uploads what changes between passes, from b->pass to the end of box
- * `boxes` - 1 (0: the pass alone). */
-static void upload_pass(GLuint buf, const veil_sweep_block* b, int boxes)
-{
-    const size_t from = offsetof(veil_sweep_block, pass);
-    const size_t to = offsetof(veil_sweep_block, boxes) + (size_t)boxes * sizeof b->boxes[0];
-    glNamedBufferSubData(buf, (GLintptr)from, (GLsizeiptr)(to - from), &b->pass);
-}
-
-static void dispatch_boxes(GLuint buf, veil_sweep_block* blk, int mode, const veil__box* boxes, int count)
+/* Adds a pass of `mode` over boxes[0..count) to run (work group z takes
+ * box z), with base's texture, light and channel. */
+static veil_result add_boxes(veil_pass_run* run, const veil_sweep_block* base, int mode, const veil__box* boxes,
+                             int count, veil_error* err)
 {
     int most = 0;
     for (int b = 0; b < count; ++b) {
+        int size = boxes[b].n[0] * boxes[b].n[1] * boxes[b].n[2];
+        most = size > most ? size : most;
+    }
+    void* mem = NULL;
+    veil_result r = veil_pass_run_add(run, veil_groups(most, VEIL_SWEEP_GROUP), 1, (GLuint)count, &mem, err);
+    if (r != VEIL_OK) return r;
+    veil_sweep_block* blk = mem;
+    *blk = *base;
+    blk->pass[0] = mode;
+    for (int b = 0; b < count; ++b)
         for (int a = 0; a < 3; ++a) {
             blk->boxes[b].lo[a] = boxes[b].lo[a];
             blk->boxes[b].n[a] = boxes[b].n[a];
         }
-        int size = boxes[b].n[0] * boxes[b].n[1] * boxes[b].n[2];
-        most = size > most ? size : most;
-    }
-    blk->pass[0] = mode;
-    upload_pass(buf, blk, count);
-    glDispatchCompute(veil_groups(most, VEIL_SWEEP_GROUP), 1, (GLuint)count);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    return VEIL_OK;
 }
 
-/* The passes of one light; blk holds the texture's settings and the
- * light's channel, its buffer is buf. */
-static int sweep_light(GLuint buf, veil_sweep_block* blk, const veil_grid* g, const veil_index_light* L,
-                       veil_opv_method method)
+/* The passes of light L in their order, into run (emptied first); base
+ * holds the texture's settings and the light's channel, and gets the light. */
+static veil_result plan_light(veil_pass_run* run, veil_sweep_block* base, const veil_grid* g,
+                              const veil_index_light* L, veil_opv_method method, veil_error* err)
 {
+    veil_pass_run_clear(run);
     for (int a = 0; a < 3; ++a) {
-        blk->light[a] = L->v[a];
-        blk->cell[a] = L->c[a];
+        base->light[a] = L->v[a];
+        base->cell[a] = L->c[a];
     }
-    blk->light[3] = 0.0f;
-    blk->cell[3] = L->type;
-    /* the texture's and the light's part; each pass then uploads its own */
-    glNamedBufferSubData(buf, 0, (GLsizeiptr)offsetof(veil_sweep_block, pass), blk);
-    int passes = 0;
+    base->light[3] = 0.0f;
+    base->cell[3] = L->type;
+    veil_result r = VEIL_OK;
     if (method == VEIL_OPV_SWEEP) {
         veil__gather_plan plan;
         veil__gather_plan_make(g, L, &plan);
         int u = plan.solve == 0 ? 1 : 0, w = plan.solve == 2 ? 1 : 2;
-        blk->pass[0] = 0;
-        blk->pass[2] = plan.solve;
-        for (int m = plan.first; m <= plan.last; ++m, ++passes) {
-            blk->pass[1] = m;
-            upload_pass(buf, blk, 0);
-            glDispatchCompute(veil_groups(g->dims[u] * g->dims[w], VEIL_SWEEP_GROUP), 1, 1);
-            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        for (int m = plan.first; m <= plan.last && r == VEIL_OK; ++m) {
+            void* mem = NULL;
+            r = veil_pass_run_add(run, veil_groups(g->dims[u] * g->dims[w], VEIL_SWEEP_GROUP), 1, 1, &mem, err);
+            if (r != VEIL_OK) break;
+            veil_sweep_block* blk = mem;
+            *blk = *base;
+            blk->pass[0] = 0, blk->pass[1] = m, blk->pass[2] = plan.solve;
         }
-        return passes;
+        return r;
     }
     veil__box box;
     if (L->type == VEIL_LIGHT_DIRECTIONAL) {
         int a = veil__sl_sun_axis(L);
-        for (int k = 0; k < g->dims[a]; ++k, ++passes) {
+        for (int k = 0; k < g->dims[a] && r == VEIL_OK; ++k) {
             veil__sl_sun_slice(g, L, k, &box);
-            dispatch_boxes(buf, blk, 2, &box, 1);
+            r = add_boxes(run, base, 2, &box, 1, err);
         }
-        return passes;
+        return r;
     }
-    if (veil__sl_near_box(g, L, &box)) {
-        dispatch_boxes(buf, blk, 1, &box, 1);
-        ++passes;
-    }
+    if (veil__sl_near_box(g, L, &box)) r = add_boxes(run, base, 1, &box, 1, err);
     int s0, s1;
     veil__sl_shell_range(g, L, &s0, &s1);
-    for (int s = s0; s <= s1; ++s)
-        for (int k = 1; k <= 3; ++k) {
+    for (int s = s0; s <= s1 && r == VEIL_OK; ++s)
+        for (int k = 1; k <= 3 && r == VEIL_OK; ++k) {
             veil__box boxes[VEIL_SL_MAX_BOXES];
             int nb = veil__sl_boxes(g, L, s, k, boxes);
-            if (nb == 0) continue;
-            dispatch_boxes(buf, blk, 2, boxes, nb);
-            ++passes;
+            if (nb > 0) r = add_boxes(run, base, 2, boxes, nb, err);
         }
-    return passes;
+    return r;
 }
 
 veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, const veil_index_light* lights,
@@ -219,7 +208,6 @@ veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, co
         blk.params[0] = g->voxel;
         blk.params[1] = veil_opv_exit_steps(params);
         blk.pass[3] = veil_opv_characteristic(params);
-        glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, p->sweep_block);
         for (int t = 0; 4 * t < n_lights && r == VEIL_OK; ++t) {
             GLint format = 0;
             glGetTextureLevelParameteriv(opv[t], 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
@@ -231,10 +219,17 @@ veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, co
             glUseProgram(one ? p->sweep_one : p->sweep);
             glClearTexImage(opv[t], 0, one ? GL_RED : GL_RGBA, GL_FLOAT, zero);
             glBindImageTexture(VEIL_IMAGE_OPV_DST, opv[t], 0, GL_TRUE, 0, GL_READ_WRITE, one ? GL_R32F : GL_RGBA32F);
-            for (int c = 0; c < 4 && 4 * t + c < n_lights; ++c) {
+            for (int c = 0; c < 4 && 4 * t + c < n_lights && r == VEIL_OK; ++c) {
                 if (lights[4 * t + c].elsewhere) continue; /* its channel stays 0 */
                 blk.dims[3] = c;
-                int passes = sweep_light(p->sweep_block, &blk, g, &lights[4 * t + c], params->method);
+                r = plan_light(&p->sweep_run, &blk, g, &lights[4 * t + c], params->method, err);
+                if (r == VEIL_OK) r = veil_pass_run_upload(&p->sweep_run, err);
+                if (r != VEIL_OK) break;
+                for (size_t k = 0; k < p->sweep_run.count; ++k) { /* each pass reads only earlier passes' voxels */
+                    veil_pass_run_dispatch(&p->sweep_run, VEIL_UBO_PROPAGATE, k);
+                    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+                }
+                int passes = (int)p->sweep_run.count;
                 most = passes > most ? passes : most;
             }
         }

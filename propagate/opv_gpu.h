@@ -9,13 +9,15 @@
 
 #include <epoxy/gl.h>
 
+#include "../gpu/pass_run.h"
 #include "opv.h"
 #include "opv_blocks.glsl.h"
 
 typedef struct veil_opv_programs {
     GLuint jacobi, sweep;
     GLuint sweep_one; /* the sweep on an r32f texture of one light, made when first needed */
-    GLuint jacobi_block, sweep_block; /* their uniform buffers: veil_jacobi_block, veil_sweep_block */
+    GLuint jacobi_block;     /* the Jacobi step's uniform buffer (veil_jacobi_block) */
+    veil_pass_run sweep_run; /* an ordered method's passes for one light (veil_sweep_block each) */
 } veil_opv_programs;
 
 veil_result veil_opv_programs_create(veil_opv_programs* p, veil_error* err);

@@ -1,7 +1,6 @@
 #include "opv_set.h"
 
 #include <math.h>
-#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -16,7 +15,8 @@ struct veil_opv_set {
     veil_opv_programs programs;
     GLuint sparse_program; /* propagate/shaders/propagate_sparse.comp, made when first needed */
     GLuint sun_program;    /* propagate/shaders/sun_prefix.comp, made when first needed */
-    GLuint sparse_block, sun_block; /* their uniform buffers (veil_sparse_od_block, veil_sun_block), made with them */
+    veil_pass_run sparse_run; /* the sparse passes of one light (a veil_sparse_od_block each) */
+    GLuint sun_block;         /* the prefix sums' uniform buffer (veil_sun_block), made with the program */
     GLuint tex[VEIL_MAX_OPV_TEXTURES];
     int dims[VEIL_MAX_OPV_TEXTURES][3];
     GLenum format[VEIL_MAX_OPV_TEXTURES]; /* rgba32f, or r32f for one light on the grid (ordered methods) */
@@ -31,6 +31,7 @@ veil_result veil_opv_set_create(veil_opv_set** out, veil_error* err)
     *out = NULL;
     veil_opv_set* s = calloc(1, sizeof *s);
     if (!s) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the optical-depth volumes");
+    veil_pass_run_init(&s->sparse_run, sizeof(veil_sparse_od_block), "veil sparse optical depth blocks");
     veil_result r = veil_opv_programs_create(&s->programs, err);
     if (r != VEIL_OK) {
         free(s);
@@ -63,7 +64,7 @@ void veil_opv_set_destroy(veil_opv_set* s)
     veil_opv_set_clear(s);
     glDeleteProgram(s->sparse_program);
     glDeleteProgram(s->sun_program);
-    glDeleteBuffers(1, &s->sparse_block);
+    veil_pass_run_free(&s->sparse_run);
     glDeleteBuffers(1, &s->sun_block);
     veil_opv_programs_destroy(&s->programs);
     free(s);
@@ -133,10 +134,7 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
                                  GLuint tex, int* passes, veil_error* err)
 {
     veil_result r = VEIL_OK;
-    if (!s->sparse_block)
-        r = veil_gl_buffer(NULL, sizeof(veil_sparse_od_block), GL_DYNAMIC_STORAGE_BIT, "veil sparse optical depth block",
-                           &s->sparse_block, err);
-    if (r == VEIL_OK && !s->sparse_program)
+    if (!s->sparse_program)
         r = veil_gpu_program("propagate/shaders/propagate_sparse.comp", &s->sparse_program, err);
     if (r != VEIL_OK) return r;
     size_t n = sp->slots;
@@ -193,27 +191,35 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
         glDeleteBuffers(1, &buf);
         list_tex = buf = 0;
         r = veil_gl_buffer(list, n * sizeof *list, 0, "veil sparse pass order", &buf, err);
+        /* the light's passes, level by level, each level in dispatches of at most 65535 bricks (GL's
+         * guaranteed work groups per dispatch) */
+        veil_pass_run_clear(&s->sparse_run);
+        for (size_t k = 0; k < levels && r == VEIL_OK; ++k)
+            for (size_t g = 0; g < first[k + 1] - first[k] && r == VEIL_OK; g += 65535) {
+                size_t m = first[k + 1] - first[k] - g;
+                void* mem = NULL;
+                r = veil_pass_run_add(&s->sparse_run, (GLuint)(m < 65535 ? m : 65535), 1, 1, &mem, err);
+                if (r != VEIL_OK) break;
+                veil_sparse_od_block* b = mem;
+                *b = blk;
+                b->pass[1] = (int32_t)(first[k] + g); /* the dispatch's first entry of the list */
+            }
+        if (r == VEIL_OK) r = veil_pass_run_upload(&s->sparse_run, err);
         if (r != VEIL_OK) break;
         glCreateTextures(GL_TEXTURE_BUFFER, 1, &list_tex);
         glTextureBuffer(list_tex, GL_R32I, buf);
         glUseProgram(p);
-        glNamedBufferSubData(s->sparse_block, 0, sizeof blk, &blk);
-        glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, s->sparse_block);
         veil_ev_sparse_bind(sp);
         glBindTextureUnit(VEIL_TEX_EV, sp->atlas);
         glBindTextureUnit(VEIL_TEX_SPARSE_LIST, list_tex);
         glBindTextureUnit(VEIL_TEX_OPV0, tex);
         glBindImageTexture(VEIL_IMAGE_SPARSE_OUT, tex, 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
         int done = 0;
+        size_t next = 0; /* the run's next dispatch */
         for (size_t k = 0; k < levels; ++k) { /* rank 0, the bricks nearest the light, first */
             size_t m = first[k + 1] - first[k];
             if (!m) continue;
-            for (size_t g = 0; g < m; g += 65535) { /* GL's guaranteed work groups per dispatch */
-                blk.pass[1] = (int32_t)(first[k] + g);
-                glNamedBufferSubData(s->sparse_block, (GLintptr)offsetof(veil_sparse_od_block, pass),
-                                     sizeof blk.pass, blk.pass);
-                glDispatchCompute((GLuint)(m - g < 65535 ? m - g : 65535), 1, 1);
-            }
+            for (size_t g = 0; g < m; g += 65535) veil_pass_run_dispatch(&s->sparse_run, VEIL_UBO_PROPAGATE, next++);
             glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
             ++done;
         }

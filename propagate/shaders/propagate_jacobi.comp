@@ -19,7 +19,11 @@ int g_channel; // the light being gathered (read by VEIL_DIN)
 
 #define VEIL_CTX_PARAM
 #define VEIL_CTX_ARG
-#define VEIL_DIMS(a) jb.dims[a]
+// the grid's size, copied from the block once an invocation (main) so that
+// the scheme's per-sample reads come from a register (a uniform block read
+// after an image store is read again)
+ivec3 g_dims;
+#define VEIL_DIMS(a) g_dims[a]
 #define VEIL_RHO(i, j, k) imageLoad(u_ev, ivec3(i, j, k)).r
 #define VEIL_DIN(i, j, k) imageLoad(u_src, ivec3(i, j, k))[g_channel]
 //@include propagate/opv_schemes.glsl.h
@@ -27,7 +31,8 @@ int g_channel; // the light being gathered (read by VEIL_DIN)
 void main()
 {
     ivec3 x = ivec3(gl_GlobalInvocationID);
-    if (any(greaterThanEqual(x, jb.dims.xyz))) return;
+    g_dims = jb.dims.xyz;
+    if (any(greaterThanEqual(x, g_dims))) return;
     vec4 old = imageLoad(u_src, x);
     vec4 result = vec4(0.0);
     for (int c = 0; c < jb.dims.w; ++c) {

@@ -26,7 +26,11 @@ layout(std140, binding = VEIL_UBO_PROPAGATE) uniform veil_sweep_ubo { veil_sweep
 
 #define VEIL_CTX_PARAM
 #define VEIL_CTX_ARG
-#define VEIL_DIMS(a) sw.dims[a]
+// the grid's size, copied from the block once an invocation (main) so that
+// the scheme's per-sample reads come from a register (a uniform block read
+// after an image store is read again)
+ivec3 g_dims;
+#define VEIL_DIMS(a) g_dims[a]
 #define VEIL_RHO(i, j, k) imageLoad(u_ev, ivec3(i, j, k)).r
 #ifdef VEIL_OPV_ONE_CHANNEL
 #define VEIL_DIN(i, j, k) imageLoad(u_opv, ivec3(i, j, k)).r
@@ -84,6 +88,7 @@ void gather_pass(uint idx)
 void main()
 {
     uint idx = gl_GlobalInvocationID.x;
+    g_dims = sw.dims.xyz;
     if (sw.pass.x == 0) {
         gather_pass(idx);
         return;
