@@ -200,6 +200,20 @@ VEIL_STRUCT_BEGIN(veil_sparse_block)
     VEIL_V4(dims);       /* xyz: the grid's voxels per axis (float); w: - */
 VEIL_STRUCT_END(veil_sparse_block)
 
+/* ---- passes over the extinction volume's voxels (volume/) -------------- */
+
+/* The RBF splat (volume/shaders/inject_rbf.comp) and the occupancy bricks
+ * (volume/shaders/occupancy.comp) read the grid from this block. */
+#define VEIL_UBO_GRID 5
+VEIL_STRUCT_BEGIN(veil_grid_block)
+    VEIL_IV4(dims);   /* xyz: the EV's voxels; w: the splat: this dispatch's first layer of bricks */
+    VEIL_IV4(bricks); /* xyz: VEIL_BRICK^3 bricks per axis; w: - */
+    VEIL_V4(origin);  /* xyz: the grid's min corner (m); w: voxel edge (m) */
+VEIL_STRUCT_END(veil_grid_block)
+#ifndef VEIL_GLSL
+_Static_assert(sizeof(veil_grid_block) == 48, "veil_grid_block: std140, three 16-byte members");
+#endif
+
 /* ---- screen-space multiple scattering (render/spread.h) ---------------- */
 
 #define VEIL_SPREAD_GROUP 8     /* 8x8 pixels per work group, every spread pass */
