@@ -134,8 +134,7 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
                                  GLuint tex, int* passes, veil_error* err)
 {
     veil_result r = VEIL_OK;
-    if (!s->sparse_program)
-        r = veil_gpu_program("propagate/shaders/propagate_sparse.comp", &s->sparse_program, err);
+    if (!s->sparse_program) r = veil_gpu_program("propagate/shaders/propagate_sparse.comp", &s->sparse_program, err);
     if (r != VEIL_OK) return r;
     size_t n = sp->slots;
     long long* level = malloc((n ? n : 1) * sizeof *level);
