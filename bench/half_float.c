@@ -265,8 +265,8 @@ static void ev_section(const veil_grid* g, float* const base[N_MEDIA])
 static void opv_section(const veil_grid* g, float* const base[N_MEDIA])
 {
     size_t nv = veil_grid_voxels(g);
-    veil_opv_light ol[3];
-    for (int l = 0; l < 3; ++l) veil_opv_light_from_world(g, &lights[l], &ol[l]);
+    veil_index_light ol[3];
+    for (int l = 0; l < 3; ++l) veil_light_to_index(&lights[l], g->dims, g->origin, g->voxel, &ol[l]);
     float* D[N_MEDIA];
     double peak[N_MEDIA];
     veil_opv_params params = {.method = VEIL_OPV_DEFAULT};
@@ -553,8 +553,8 @@ static void gpu_render(veil_gl* gl, veil_error* err)
         veil_render_stats st;
         int nan = 0, inf = 0, dnan = 0, dinf = 0;
         float* D = malloc(N * N * N * sizeof(float));
-        veil_opv_light ol;
-        veil_opv_light_from_world(&g, &sun, &ol);
+        veil_index_light ol;
+        veil_light_to_index(&sun, g.dims, g.origin, g.voxel, &ol);
         veil_opv_params params = {.method = VEIL_OPV_DEFAULT};
         int it = 0;
         if (D && veil_renderer_propagate(r, &g, rho, &ol, 1, &params, D, &it, err) == VEIL_OK)

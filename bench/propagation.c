@@ -229,7 +229,7 @@ static int cmp_double(const void* a, const void* b)
 
 /* Runs veil_opv_gpu `runs` times (once when the first run exceeds
  * REPEAT_LIMIT_MS); *median_ms, *passes, *runs_done. */
-static veil_result time_opv(bench* b, const veil_grid* g, GLuint ev, const veil_opv_light* lights, int n_lights,
+static veil_result time_opv(bench* b, const veil_grid* g, GLuint ev, const veil_index_light* lights, int n_lights,
                             const veil_opv_params* params, const GLuint* opv, int runs, double* median_ms,
                             int* passes, int* runs_done, veil_error* err)
 {
@@ -551,8 +551,8 @@ int main(int argc, char** argv)
                              "reference is exact to rounding by construction",
                              medium_names[m], n, light_names[l], k, worst, worst_rel, dmax);
                 }
-                veil_opv_light L;
-                veil_opv_light_from_world(&g, &bench_lights[l], &L);
+                veil_index_light L;
+                veil_light_to_index(&bench_lights[l], g.dims, g.origin, g.voxel, &L);
                 for (int meth = VEIL_OPV_JACOBI; meth < VEIL_OPV_METHOD_COUNT && status == 0; ++meth) {
                     if (!use_method[meth]) continue;
                     row r = {.table = "methods", .method = veil_opv_method_name((veil_opv_method)meth), .grid = n,
@@ -601,12 +601,12 @@ int main(int argc, char** argv)
             fprintf(stderr, "propagation: per-light: %s\n", err.msg);
             status = 1;
         } else {
-            veil_opv_light L[VEIL_MAX_LIGHTS];
+            veil_index_light L[VEIL_MAX_LIGHTS];
             uint64_t rng = 0x11647ULL;
             for (int i = 0; i < VEIL_MAX_LIGHTS; ++i) {
                 veil_light w = {.type = VEIL_LIGHT_POINT, .color = {1, 1, 1}};
                 for (int a = 0; a < 3; ++a) w.position[a] = (float)(-1.6 + 3.2 * uniform01(&rng));
-                veil_opv_light_from_world(&p.g, &w, &L[i]);
+                veil_light_to_index(&w, p.g.dims, p.g.origin, p.g.voxel, &L[i]);
             }
             static const int counts[] = {1, 4, 8, 16};
             veil_opv_params params = {.method = def, .tolerance = p.ms.tolerance};
@@ -664,8 +664,8 @@ int main(int argc, char** argv)
             }
             for (int l = 0; l < LIGHT_COUNT && status == 0; ++l) {
                 reference_depths(&g, p.rho, &bench_lights[l], samples, n_samples, dref);
-                veil_opv_light L;
-                veil_opv_light_from_world(&g, &bench_lights[l], &L);
+                veil_index_light L;
+                veil_light_to_index(&bench_lights[l], g.dims, g.origin, g.voxel, &L);
                 for (int s = 0; s < KNOBS && status == 0; ++s) {
                     row r = {.table = "sl-knobs", .method = "semi-lagrangian", .grid = side,
                              .medium = medium_names[m], .light = light_names[l], .lights = 1,

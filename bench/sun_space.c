@@ -201,8 +201,8 @@ int main(int argc, char** argv)
                     for (int a = 0; a < 3; ++a) samples[s][a] = lo[a] + (hi[a] - lo[a]) * veil_rng_double53(&rng);
                     dref[s] = veil_ref_optical_depth(&g, rho, &l, samples[s], 1.0);
                 }
-                veil_opv_light ol;
-                veil_opv_light_from_world(&g, &l, &ol);
+                veil_index_light ol;
+                veil_light_to_index(&l, g.dims, g.origin, g.voxel, &ol);
                 for (int c = 0; c < CONFIGS && status == 0; ++c) {
                     const config* cf = &configs[c];
                     veil_sun_space sp;

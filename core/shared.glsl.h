@@ -107,6 +107,7 @@
 #define VEIL_IMAGE_AOV_V 6      /* image unit: rgba32f march AOV: volumetric multiple scattering rgb */
 #define VEIL_IMAGE_AOV_Q 7      /* image unit: rgba32f march AOV: single scattering's out-scattered rgb, its P */
 #define VEIL_UBO_MARCH 0        /* uniform block: veil_march_block */
+#define VEIL_UBO_PROPAGATE 4    /* uniform block: the optical-depth pass's own (propagate/opv_blocks.glsl.h) */
 #define VEIL_UBO_MEDIUM 6       /* uniform block: veil_medium_block (the march and the volumetric stage) */
 #define VEIL_TEX_EV 0           /* texture unit: sampled EV */
 #define VEIL_TEX_OPV0 1         /* texture units 1..4: sampled OPVs */
@@ -121,7 +122,7 @@
 #define VEIL_TEX_SUN0 9
 
 /* A light as the GPU sees it: one shape for every shader (std140, 48 bytes).
- * Filled from scene/scene.h's veil_light by veil_gpu_light_from(). */
+ * Filled from scene/light.h's veil_light by veil_light_to_gpu(). */
 VEIL_STRUCT_BEGIN(veil_gpu_light)
     VEIL_V4(position);  /* xyz: point, spot position (m); w: type, VEIL_LIGHT_* */
     VEIL_V4(direction); /* xyz: directional: unit travel direction; spot: its axis; w: spot cos(inner angle),
@@ -210,6 +211,20 @@ VEIL_STRUCT_BEGIN(veil_sparse_block)
     VEIL_V4(inv_atlas);  /* xyz: 1 / atlas texels per axis; w: - */
     VEIL_V4(dims);       /* xyz: the grid's voxels per axis (float); w: - */
 VEIL_STRUCT_END(veil_sparse_block)
+
+/* ---- passes over the extinction volume's voxels (volume/) -------------- */
+
+/* The RBF splat (volume/shaders/inject_rbf.comp) and the occupancy bricks
+ * (volume/shaders/occupancy.comp) read the grid from this block. */
+#define VEIL_UBO_GRID 5
+VEIL_STRUCT_BEGIN(veil_grid_block)
+    VEIL_IV4(dims);   /* xyz: the EV's voxels; w: the splat: this dispatch's first layer of bricks */
+    VEIL_IV4(bricks); /* xyz: VEIL_BRICK^3 bricks per axis; w: - */
+    VEIL_V4(origin);  /* xyz: the grid's min corner (m); w: voxel edge (m) */
+VEIL_STRUCT_END(veil_grid_block)
+#ifndef VEIL_GLSL
+_Static_assert(sizeof(veil_grid_block) == 48, "veil_grid_block: std140, three 16-byte members");
+#endif
 
 /* ---- screen-space multiple scattering (render/spread.h) ---------------- */
 

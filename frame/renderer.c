@@ -139,7 +139,7 @@ veil_result veil_renderer_inject(veil_renderer* r, const veil_grid* g, const vei
 }
 
 veil_result veil_renderer_propagate(veil_renderer* r, const veil_grid* g, const float* density,
-                                    const veil_opv_light* lights, int n_lights, const veil_opv_params* params,
+                                    const veil_index_light* lights, int n_lights, const veil_opv_params* params,
                                     float* out, int* iterations, veil_error* err)
 {
     return veil_opv_set_propagate_readback(r->parts.opv, g, density, lights, n_lights, params, out, iterations, err);

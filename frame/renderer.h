@@ -56,7 +56,7 @@ veil_result veil_render_density(veil_renderer* r, const veil_scene* s, const vei
 veil_result veil_renderer_inject(veil_renderer* r, const veil_grid* g, const veil_particle* p, size_t n,
                                  float* density, veil_error* err);
 veil_result veil_renderer_propagate(veil_renderer* r, const veil_grid* g, const float* density,
-                                    const veil_opv_light* lights, int n_lights, const veil_opv_params* params,
+                                    const veil_index_light* lights, int n_lights, const veil_opv_params* params,
                                     float* out, int* iterations, veil_error* err);
 
 #endif

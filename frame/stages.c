@@ -315,8 +315,8 @@ static uint64_t propagate_key(const veil_frame_plan* p)
     keyed.sun_bytes = 0.0; /* as the textures' keys: the allowance shows through the grids it makes */
     uint64_t key = veil_hash_bytes(p->ev_key, &keyed, sizeof keyed);
     for (int l = 0; l < p->light_count; ++l) {
-        veil_opv_light ol;
-        veil_opv_light_from_world(p->grid, &p->lights[l], &ol);
+        veil_index_light ol;
+        veil_light_to_index(&p->lights[l], p->grid->dims, p->grid->origin, p->grid->voxel, &ol);
         key = veil_hash_bytes(key, &ol, sizeof ol);
     }
     return key;
@@ -344,7 +344,7 @@ static veil_stage_status propagate_decide(const veil_frame_plan* p, int kept, ch
     }
     /* the textures and light-space grids it will make (the GL's 3D textures reach at least
      * VEIL_GL_MIN_3D_TEXTURE texels an axis; a device may allow more) */
-    veil_opv_light ol[VEIL_MAX_LIGHTS];
+    veil_index_light ol[VEIL_MAX_LIGHTS];
     veil_opv_sun suns[VEIL_MAX_SUNS];
     uint64_t sun_keys[VEIL_MAX_SUNS];
     int n_suns = veil_opv_plan_suns(p->grid, p->ev_key, p->lights, p->light_count, &p->opv,

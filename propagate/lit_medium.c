@@ -8,14 +8,6 @@ static void set3(float dst[4], const float src[3], float w)
     dst[0] = src[0], dst[1] = src[1], dst[2] = src[2], dst[3] = w;
 }
 
-void veil_gpu_light_from(const veil_light* l, veil_gpu_light* out)
-{
-    set3(out->position, l->position, (float)l->type);
-    set3(out->direction, l->direction,
-         l->type == VEIL_LIGHT_POINT ? l->radius * l->radius : cosf(l->inner_angle_deg * (float)(VEIL_PI / 180.0)));
-    set3(out->color, l->color, cosf(l->outer_angle_deg * (float)(VEIL_PI / 180.0)));
-}
-
 void veil_lit_medium_fill(const veil_lit_medium* d, veil_medium_block* u)
 {
     memset(u, 0, sizeof *u);
@@ -50,7 +42,7 @@ void veil_lit_medium_fill(const veil_lit_medium* d, veil_medium_block* u)
         set3(f->box_max, src->fog.bounds[1], 0.0f);
     }
     int n = d->light_count < VEIL_MAX_LIGHTS ? d->light_count : VEIL_MAX_LIGHTS;
-    for (int l = 0; l < n; ++l) veil_gpu_light_from(&d->lights[l], &u->lights[l]);
+    for (int l = 0; l < n; ++l) veil_light_to_gpu(&d->lights[l], &u->lights[l]);
     u->counts[0] = n, u->counts[1] = fogs, u->counts[2] = d->grid != NULL;
     for (int k = 0; d->grid && !d->sparse && k < d->sun_count && k < VEIL_MAX_SUNS; ++k) {
         int l = d->suns[k].light;

@@ -16,6 +16,7 @@
 #include <epoxy/gl.h>
 
 #include "../core/shared.glsl.h"
+#include "../scene/light.h"
 #include "../scene/scene.h"
 #include "../volume/ev.h"
 #include "../volume/volume.h"
@@ -42,15 +43,13 @@ typedef struct veil_lit_medium {
     int sun_count;
 } veil_lit_medium;
 
-/* The uniform block for m (exposed so tests can check what the shaders get). */
+/* The uniform block for m (exposed so tests can check what the shaders
+ * get); each light converted by veil_light_to_gpu (scene/light.h). */
 void veil_lit_medium_fill(const veil_lit_medium* m, veil_medium_block* out);
 
 /* Binds m's optical depths (OPV textures and, over a dense volume, the
  * light-space grids) for a pass that reads lit_medium.glsl; NULL unbinds
  * them all (call it so only where no sparse table holds the sun units). */
 void veil_lit_medium_bind_depths(const veil_lit_medium* m);
-
-/* One light in the GPU's shape. */
-void veil_gpu_light_from(const veil_light* l, veil_gpu_light* out);
 
 #endif

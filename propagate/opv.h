@@ -38,6 +38,7 @@
 
 #include "../core/result.h"
 #include "../core/shared.glsl.h"
+#include "../scene/light.h"
 #include "../scene/scene.h"
 #include "../volume/volume.h"
 #include "sun_space.h"
@@ -65,18 +66,8 @@ const char* veil_opv_method_name(veil_opv_method m);
 /* 1 on success; names as above */
 int veil_opv_method_parse(const char* name, veil_opv_method* out);
 
-/* A light in voxel index space (voxel i's centre at coordinate i). */
-typedef struct veil_opv_light {
-    int type;      /* VEIL_LIGHT_POINT (spot lights too) or VEIL_LIGHT_DIRECTIONAL */
-    float v[3];    /* point: position (index units); directional: unit vector toward the light */
-    int c[3];      /* point: the light's voxel, floor(v + 1/2) (it may lie outside the grid, at most
-                      VEIL_OPV_FAR voxels beyond it: opv_cpu.c says why that changes nothing) */
-    int elsewhere; /* 1: its optical depth is kept in a light-space grid; the ordered methods leave its
-                      channel 0 (veil_opv_gpu; the Jacobi steps compute all four channels anyway) */
-} veil_opv_light;
-
-void veil_opv_light_from_world(const veil_grid* g, const veil_light* l, veil_opv_light* out);
-#define VEIL_OPV_FAR 1048576 /* 2^20 voxels */
+/* The lights work in voxel index space: veil_index_light, made from a
+ * scene's veil_light by veil_light_to_index() (scene/light.h). */
 
 /* Jacobi steps between convergence checks (each check is a GPU read-back). */
 #define VEIL_JACOBI_CHECK_EVERY 8
@@ -128,7 +119,7 @@ int veil_opv_exact_iterations(const veil_grid* g);
 /* C version of every method: out holds n_lights * voxels floats,
  * light-major, x fastest. *iterations: Jacobi steps, or passes (dispatches
  * on the GPU) of an ordered method. */
-veil_result veil_opv_cpu(const veil_grid* g, const float* rho, const veil_opv_light* lights, int n_lights,
+veil_result veil_opv_cpu(const veil_grid* g, const float* rho, const veil_index_light* lights, int n_lights,
                          const veil_opv_params* params, float* out, int* iterations, veil_error* err);
 
 #endif

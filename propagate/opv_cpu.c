@@ -46,32 +46,12 @@ int veil_opv_method_parse(const char* name, veil_opv_method* out)
     return 0;
 }
 
-void veil_opv_light_from_world(const veil_grid* g, const veil_light* l, veil_opv_light* out)
-{
-    memset(out, 0, sizeof *out);
-    out->type = l->type == VEIL_LIGHT_DIRECTIONAL ? VEIL_LIGHT_DIRECTIONAL : VEIL_LIGHT_POINT;
-    for (int a = 0; a < 3; ++a) {
-        if (out->type == VEIL_LIGHT_POINT) {
-            out->v[a] = (l->position[a] - g->origin[a]) / g->voxel - 0.5f;
-            /* The light's voxel, at most VEIL_OPV_FAR voxels beyond the grid on each axis: further
-             * out, every voxel's distance to it along that axis grows by the same amount, so the
-             * ordered passes take the voxels in the same order, and sums of three such distances
-             * stay far inside int (a light at 1e15 m made them overflow: undefined behaviour). */
-            double c = floor((double)out->v[a] + 0.5);
-            double lo = -VEIL_OPV_FAR, hi = (double)g->dims[a] - 1.0 + VEIL_OPV_FAR;
-            out->c[a] = (int)(c < lo ? lo : c > hi ? hi : c);
-        } else {
-            out->v[a] = -l->direction[a];
-        }
-    }
-}
-
 int veil_opv_exact_iterations(const veil_grid* g)
 {
     return g->dims[0] + g->dims[1] + g->dims[2] + 1;
 }
 
-static void jacobi(const veil_grid* g, const float* rho, const veil_opv_light* L, const veil_opv_params* p,
+static void jacobi(const veil_grid* g, const float* rho, const veil_index_light* L, const veil_opv_params* p,
                    float* cur, float* tmp, int* iterations)
 {
     veil__opv_ctx ctx = {.rho = rho, .din = cur, .dims = {g->dims[0], g->dims[1], g->dims[2]}};
@@ -98,7 +78,7 @@ static void jacobi(const veil_grid* g, const float* rho, const veil_opv_light* L
     *iterations = it;
 }
 
-static void gather_sweep(const veil_grid* g, const float* rho, const veil_opv_light* L, float* out, int* passes)
+static void gather_sweep(const veil_grid* g, const float* rho, const veil_index_light* L, float* out, int* passes)
 {
     veil__opv_ctx ctx = {.rho = rho, .din = out, .dims = {g->dims[0], g->dims[1], g->dims[2]}};
     veil__gather_plan plan;
@@ -128,14 +108,14 @@ static void gather_sweep(const veil_grid* g, const float* rho, const veil_opv_li
         for (x[1] = (b).lo[1]; x[1] < (b).lo[1] + (b).n[1]; ++x[1])                  \
             for (x[0] = (b).lo[0]; x[0] < (b).lo[0] + (b).n[0]; ++x[0])
 
-static float sl_voxel(const veil__opv_ctx* ctx, const veil_opv_light* L, const int x[3], float h, int k,
+static float sl_voxel(const veil__opv_ctx* ctx, const veil_index_light* L, const int x[3], float h, int k,
                       float exit_steps)
 {
     int a = veil_sl_axis(x[0], x[1], x[2], L->type, L->v[0], L->v[1], L->v[2], L->c[0], L->c[1], L->c[2]);
     return veil_sl_cell(ctx, x[0], x[1], x[2], a, L->type, L->v[0], L->v[1], L->v[2], h, k, exit_steps);
 }
 
-static void semi_lagrangian(const veil_grid* g, const float* rho, const veil_opv_light* L, int chars, float exit_steps,
+static void semi_lagrangian(const veil_grid* g, const float* rho, const veil_index_light* L, int chars, float exit_steps,
                             float* out, int* passes)
 {
     veil__opv_ctx ctx = {.rho = rho, .din = out, .dims = {g->dims[0], g->dims[1], g->dims[2]}};
@@ -166,7 +146,7 @@ static void semi_lagrangian(const veil_grid* g, const float* rho, const veil_opv
     *passes = n;
 }
 
-veil_result veil_opv_cpu(const veil_grid* g, const float* rho, const veil_opv_light* lights, int n_lights,
+veil_result veil_opv_cpu(const veil_grid* g, const float* rho, const veil_index_light* lights, int n_lights,
                          const veil_opv_params* params, float* out, int* iterations, veil_error* err)
 {
     size_t nv = veil_grid_voxels(g);

@@ -1,14 +1,20 @@
 #include "opv_gpu.h"
 
+#include <string.h>
+
 #include "../gpu/gl_util.h"
 #include "../gpu/programs.h"
 #include "opv_plan.h"
 
 veil_result veil_opv_programs_create(veil_opv_programs* p, veil_error* err)
 {
-    p->jacobi = p->sweep = p->sweep_one = 0;
+    p->jacobi = p->sweep = p->sweep_one = p->jacobi_block = 0;
+    veil_pass_run_init(&p->sweep_run, sizeof(veil_sweep_block), "veil sweep blocks");
     veil_result r = veil_gpu_program("propagate/shaders/propagate_jacobi.comp", &p->jacobi, err);
     if (r == VEIL_OK) r = veil_gpu_program("propagate/shaders/propagate_sweep.comp", &p->sweep, err);
+    if (r == VEIL_OK)
+        r = veil_gl_buffer(NULL, sizeof(veil_jacobi_block), GL_DYNAMIC_STORAGE_BIT, "veil Jacobi block",
+                           &p->jacobi_block, err);
     if (r != VEIL_OK) veil_opv_programs_destroy(p);
     return r;
 }
@@ -18,31 +24,32 @@ void veil_opv_programs_destroy(veil_opv_programs* p)
     glDeleteProgram(p->jacobi);
     glDeleteProgram(p->sweep);
     glDeleteProgram(p->sweep_one);
-    p->jacobi = p->sweep = p->sweep_one = 0;
+    glDeleteBuffers(1, &p->jacobi_block);
+    veil_pass_run_free(&p->sweep_run);
+    p->jacobi = p->sweep = p->sweep_one = p->jacobi_block = 0;
 }
-
-static GLint loc(GLuint prog, const char* name) { return glGetUniformLocation(prog, name); }
 
 /* ---- Jacobi ------------------------------------------------------------ */
 
-static void jacobi_lights(GLuint prog, const veil_opv_light* lights, int count)
+/* The block of one texture's lights (at most 4). */
+static void jacobi_block_fill(const veil_grid* g, const veil_opv_params* params, const veil_index_light* lights,
+                              int count, veil_jacobi_block* b)
 {
-    GLint types[4] = {0, 0, 0, 0}, cells[12] = {0};
-    GLfloat v[12] = {0};
+    memset(b, 0, sizeof *b);
+    b->dims[0] = g->dims[0], b->dims[1] = g->dims[1], b->dims[2] = g->dims[2], b->dims[3] = count;
+    b->mode[0] = params->method == VEIL_OPV_JACOBI_CORRECTED;
+    b->params[0] = g->voxel;
+    b->params[1] = params->tolerance;
     for (int c = 0; c < count; ++c) {
-        types[c] = lights[c].type;
         for (int a = 0; a < 3; ++a) {
-            v[3 * c + a] = lights[c].v[a];
-            cells[3 * c + a] = lights[c].c[a];
+            b->light[c][a] = lights[c].v[a];
+            b->cell[c][a] = lights[c].c[a];
         }
+        b->cell[c][3] = lights[c].type;
     }
-    glProgramUniform1i(prog, loc(prog, "u_count"), count);
-    glProgramUniform1iv(prog, loc(prog, "u_type"), 4, types);
-    glProgramUniform3fv(prog, loc(prog, "u_light"), 4, v);
-    glProgramUniform3iv(prog, loc(prog, "u_cell"), 4, cells);
 }
 
-static void jacobi_texture(GLuint prog, const veil_grid* g, GLuint target, GLuint scratch, GLuint flags, int max_it,
+static void jacobi_texture(const veil_grid* g, GLuint target, GLuint scratch, GLuint flags, int max_it,
                            int* iterations)
 {
     static const GLfloat zero[4] = {0, 0, 0, 0};
@@ -78,7 +85,7 @@ static void jacobi_texture(GLuint prog, const veil_grid* g, GLuint target, GLuin
     *iterations = it;
 }
 
-static veil_result run_jacobi(GLuint prog, const veil_grid* g, const veil_opv_light* lights, int n_lights,
+static veil_result run_jacobi(veil_opv_programs* p, const veil_grid* g, const veil_index_light* lights, int n_lights,
                               const veil_opv_params* params, const GLuint* opv, int* iterations, veil_error* err)
 {
     int max_it = params->max_iterations > 0 ? params->max_iterations : veil_opv_exact_iterations(g);
@@ -86,16 +93,18 @@ static veil_result run_jacobi(GLuint prog, const veil_grid* g, const veil_opv_li
     veil_result r = veil_gl_texture3d(GL_RGBA32F, g->dims, "veil OPV scratch", &scratch, err);
     if (r == VEIL_OK) r = veil_gl_buffer(NULL, 0, GL_DYNAMIC_STORAGE_BIT, "veil Jacobi flags", &flags, err);
     if (r == VEIL_OK) {
-        glUseProgram(prog);
-        glProgramUniform1i(prog, loc(prog, "u_corrected"), params->method == VEIL_OPV_JACOBI_CORRECTED);
-        glProgramUniform1f(prog, loc(prog, "u_tolerance"), params->tolerance);
+        glUseProgram(p->jacobi);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_FLAGS, flags);
+        glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, p->jacobi_block);
         for (int t = 0; 4 * t < n_lights; ++t) {
             int count = n_lights - 4 * t < 4 ? n_lights - 4 * t : 4, it = 0;
-            jacobi_lights(prog, lights + 4 * t, count);
-            jacobi_texture(prog, g, opv[t], scratch, flags, max_it, &it);
+            veil_jacobi_block b;
+            jacobi_block_fill(g, params, lights + 4 * t, count, &b);
+            glNamedBufferSubData(p->jacobi_block, 0, sizeof b, &b);
+            jacobi_texture(g, opv[t], scratch, flags, max_it, &it);
             if (it > *iterations) *iterations = it;
         }
+        glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, 0);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_FLAGS, 0);
         glBindImageTexture(VEIL_IMAGE_OPV_SRC, 0, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     }
@@ -106,71 +115,79 @@ static veil_result run_jacobi(GLuint prog, const veil_grid* g, const veil_opv_li
 
 /* ---- ordered one-pass methods ------------------------------------------ */
 
-static void dispatch_boxes(GLuint prog, int mode, const veil__box* boxes, int count)
+/* Adds a pass of `mode` over boxes[0..count) to run (work group z takes
+ * box z), with base's texture, light and channel. */
+static veil_result add_boxes(veil_pass_run* run, const veil_sweep_block* base, int mode, const veil__box* boxes,
+                             int count, veil_error* err)
 {
-    GLint lo[3 * VEIL_SL_MAX_BOXES], n[3 * VEIL_SL_MAX_BOXES];
     int most = 0;
     for (int b = 0; b < count; ++b) {
-        for (int a = 0; a < 3; ++a) {
-            lo[3 * b + a] = boxes[b].lo[a];
-            n[3 * b + a] = boxes[b].n[a];
-        }
         int size = boxes[b].n[0] * boxes[b].n[1] * boxes[b].n[2];
         most = size > most ? size : most;
     }
-    glProgramUniform1i(prog, loc(prog, "u_mode"), mode);
-    glProgramUniform3iv(prog, loc(prog, "u_box_lo"), count, lo);
-    glProgramUniform3iv(prog, loc(prog, "u_box_n"), count, n);
-    glDispatchCompute(veil_groups(most, VEIL_SWEEP_GROUP), 1, (GLuint)count);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    void* mem = NULL;
+    veil_result r = veil_pass_run_add(run, veil_groups(most, VEIL_SWEEP_GROUP), 1, (GLuint)count, &mem, err);
+    if (r != VEIL_OK) return r;
+    veil_sweep_block* blk = mem;
+    *blk = *base;
+    blk->pass[0] = mode;
+    for (int b = 0; b < count; ++b)
+        for (int a = 0; a < 3; ++a) {
+            blk->boxes[b].lo[a] = boxes[b].lo[a];
+            blk->boxes[b].n[a] = boxes[b].n[a];
+        }
+    return VEIL_OK;
 }
 
-static int sweep_light(GLuint prog, const veil_grid* g, const veil_opv_light* L, veil_opv_method method)
+/* The passes of light L in their order, into run (emptied first); base
+ * holds the texture's settings and the light's channel, and gets the light. */
+static veil_result plan_light(veil_pass_run* run, veil_sweep_block* base, const veil_grid* g,
+                              const veil_index_light* L, veil_opv_method method, veil_error* err)
 {
-    glProgramUniform1i(prog, loc(prog, "u_type"), L->type);
-    glProgramUniform3fv(prog, loc(prog, "u_light"), 1, L->v);
-    glProgramUniform3iv(prog, loc(prog, "u_cell"), 1, L->c);
-    int passes = 0;
+    veil_pass_run_clear(run);
+    for (int a = 0; a < 3; ++a) {
+        base->light[a] = L->v[a];
+        base->cell[a] = L->c[a];
+    }
+    base->light[3] = 0.0f;
+    base->cell[3] = L->type;
+    veil_result r = VEIL_OK;
     if (method == VEIL_OPV_SWEEP) {
         veil__gather_plan plan;
         veil__gather_plan_make(g, L, &plan);
         int u = plan.solve == 0 ? 1 : 0, w = plan.solve == 2 ? 1 : 2;
-        glProgramUniform1i(prog, loc(prog, "u_mode"), 0);
-        glProgramUniform1i(prog, loc(prog, "u_solve"), plan.solve);
-        for (int m = plan.first; m <= plan.last; ++m, ++passes) {
-            glProgramUniform1i(prog, loc(prog, "u_shell"), m);
-            glDispatchCompute(veil_groups(g->dims[u] * g->dims[w], VEIL_SWEEP_GROUP), 1, 1);
-            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        for (int m = plan.first; m <= plan.last && r == VEIL_OK; ++m) {
+            void* mem = NULL;
+            r = veil_pass_run_add(run, veil_groups(g->dims[u] * g->dims[w], VEIL_SWEEP_GROUP), 1, 1, &mem, err);
+            if (r != VEIL_OK) break;
+            veil_sweep_block* blk = mem;
+            *blk = *base;
+            blk->pass[0] = 0, blk->pass[1] = m, blk->pass[2] = plan.solve;
         }
-        return passes;
+        return r;
     }
     veil__box box;
     if (L->type == VEIL_LIGHT_DIRECTIONAL) {
         int a = veil__sl_sun_axis(L);
-        for (int k = 0; k < g->dims[a]; ++k, ++passes) {
+        for (int k = 0; k < g->dims[a] && r == VEIL_OK; ++k) {
             veil__sl_sun_slice(g, L, k, &box);
-            dispatch_boxes(prog, 2, &box, 1);
+            r = add_boxes(run, base, 2, &box, 1, err);
         }
-        return passes;
+        return r;
     }
-    if (veil__sl_near_box(g, L, &box)) {
-        dispatch_boxes(prog, 1, &box, 1);
-        ++passes;
-    }
+    if (veil__sl_near_box(g, L, &box)) r = add_boxes(run, base, 1, &box, 1, err);
     int s0, s1;
     veil__sl_shell_range(g, L, &s0, &s1);
-    for (int s = s0; s <= s1; ++s)
-        for (int k = 1; k <= 3; ++k) {
+    for (int s = s0; s <= s1 && r == VEIL_OK; ++s)
+        for (int k = 1; k <= 3 && r == VEIL_OK; ++k) {
             veil__box boxes[VEIL_SL_MAX_BOXES];
             int nb = veil__sl_boxes(g, L, s, k, boxes);
-            if (nb == 0) continue;
-            dispatch_boxes(prog, 2, boxes, nb);
-            ++passes;
+            if (nb > 0) r = add_boxes(run, base, 2, boxes, nb, err);
         }
-    return passes;
+    return r;
 }
 
-veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, const veil_opv_light* lights,
+veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, const veil_index_light* lights,
                          int n_lights, const veil_opv_params* params, const GLuint* opv, int* iterations,
                          veil_error* err)
 {
@@ -182,12 +199,15 @@ veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, co
     params = &resolved;
     glBindImageTexture(VEIL_IMAGE_EV, ev, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32F);
     if (params->method == VEIL_OPV_JACOBI || params->method == VEIL_OPV_JACOBI_CORRECTED) {
-        GLuint prog = p->jacobi;
-        glProgramUniform3i(prog, loc(prog, "u_dims"), g->dims[0], g->dims[1], g->dims[2]);
-        glProgramUniform1f(prog, loc(prog, "u_voxel"), g->voxel);
-        r = run_jacobi(prog, g, lights, n_lights, params, opv, &most, err);
+        r = run_jacobi(p, g, lights, n_lights, params, opv, &most, err);
     } else if (params->method == VEIL_OPV_SWEEP || params->method == VEIL_OPV_SEMI_LAGRANGIAN) {
         static const GLfloat zero[4] = {0, 0, 0, 0};
+        veil_sweep_block blk;
+        memset(&blk, 0, sizeof blk);
+        blk.dims[0] = g->dims[0], blk.dims[1] = g->dims[1], blk.dims[2] = g->dims[2];
+        blk.params[0] = g->voxel;
+        blk.params[1] = veil_opv_exit_steps(params);
+        blk.pass[3] = veil_opv_characteristic(params);
         for (int t = 0; 4 * t < n_lights && r == VEIL_OK; ++t) {
             GLint format = 0;
             glGetTextureLevelParameteriv(opv[t], 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
@@ -196,21 +216,24 @@ veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, co
                 r = veil_gpu_program_variant("propagate/shaders/propagate_sweep.comp", "#define VEIL_OPV_ONE_CHANNEL 1\n",
                                              "one light", &p->sweep_one, err);
             if (r != VEIL_OK) break;
-            GLuint prog = one ? p->sweep_one : p->sweep;
-            glUseProgram(prog);
-            glProgramUniform3i(prog, loc(prog, "u_dims"), g->dims[0], g->dims[1], g->dims[2]);
-            glProgramUniform1f(prog, loc(prog, "u_voxel"), g->voxel);
-            glProgramUniform1f(prog, loc(prog, "u_exit_steps"), veil_opv_exit_steps(params));
-            glProgramUniform1i(prog, loc(prog, "u_characteristic"), veil_opv_characteristic(params));
+            glUseProgram(one ? p->sweep_one : p->sweep);
             glClearTexImage(opv[t], 0, one ? GL_RED : GL_RGBA, GL_FLOAT, zero);
             glBindImageTexture(VEIL_IMAGE_OPV_DST, opv[t], 0, GL_TRUE, 0, GL_READ_WRITE, one ? GL_R32F : GL_RGBA32F);
-            for (int c = 0; c < 4 && 4 * t + c < n_lights; ++c) {
+            for (int c = 0; c < 4 && 4 * t + c < n_lights && r == VEIL_OK; ++c) {
                 if (lights[4 * t + c].elsewhere) continue; /* its channel stays 0 */
-                glProgramUniform1i(prog, loc(prog, "u_channel"), c);
-                int passes = sweep_light(prog, g, &lights[4 * t + c], params->method);
+                blk.dims[3] = c;
+                r = plan_light(&p->sweep_run, &blk, g, &lights[4 * t + c], params->method, err);
+                if (r == VEIL_OK) r = veil_pass_run_upload(&p->sweep_run, err);
+                if (r != VEIL_OK) break;
+                for (size_t k = 0; k < p->sweep_run.count; ++k) { /* each pass reads only earlier passes' voxels */
+                    veil_pass_run_dispatch(&p->sweep_run, VEIL_UBO_PROPAGATE, k);
+                    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+                }
+                int passes = (int)p->sweep_run.count;
                 most = passes > most ? passes : most;
             }
         }
+        glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, 0);
     } else {
         r = veil_fail(err, VEIL_ERR_INVALID, "unknown propagation method %d", (int)params->method);
     }

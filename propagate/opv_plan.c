@@ -5,7 +5,7 @@
 
 /* ---- gather sweep ------------------------------------------------------ */
 
-int veil__gather_dist(const veil_grid* g, const veil_opv_light* l, int a, int x)
+int veil__gather_dist(const veil_grid* g, const veil_index_light* l, int a, int x)
 {
     if (l->type == VEIL_LIGHT_DIRECTIONAL) {
         if (l->v[a] > 0.0f) return g->dims[a] - 1 - x;
@@ -26,7 +26,7 @@ static int dominant_axis(const float v[3])
     return a;
 }
 
-void veil__gather_plan_make(const veil_grid* g, const veil_opv_light* l, veil__gather_plan* p)
+void veil__gather_plan_make(const veil_grid* g, const veil_index_light* l, veil__gather_plan* p)
 {
     p->first = p->last = 0;
     if (l->type == VEIL_LIGHT_DIRECTIONAL) {
@@ -43,7 +43,7 @@ void veil__gather_plan_make(const veil_grid* g, const veil_opv_light* l, veil__g
     }
 }
 
-int veil__gather_solve(const veil_grid* g, const veil_opv_light* l, const veil__gather_plan* p, int m,
+int veil__gather_solve(const veil_grid* g, const veil_index_light* l, const veil__gather_plan* p, int m,
                        const int x[3], int out[2])
 {
     int s = p->solve, rem = m;
@@ -65,7 +65,7 @@ int veil__gather_solve(const veil_grid* g, const veil_opv_light* l, const veil__
 
 /* ---- semi-Lagrangian shells -------------------------------------------- */
 
-void veil__sl_shell_range(const veil_grid* g, const veil_opv_light* l, int* s0, int* s1)
+void veil__sl_shell_range(const veil_grid* g, const veil_index_light* l, int* s0, int* s1)
 {
     int near = 0, far = 0;
     for (int a = 0; a < 3; ++a) {
@@ -88,7 +88,7 @@ static int clip(const veil_grid* g, int a, int* lo, int* n)
     return *n > 0;
 }
 
-int veil__sl_boxes(const veil_grid* g, const veil_opv_light* l, int s, int k, veil__box out[VEIL_SL_MAX_BOXES])
+int veil__sl_boxes(const veil_grid* g, const veil_index_light* l, int s, int k, veil__box out[VEIL_SL_MAX_BOXES])
 {
     int count = 0;
     /* every choice of k axes at distance s (mask), and of their sides */
@@ -114,7 +114,7 @@ int veil__sl_boxes(const veil_grid* g, const veil_opv_light* l, int s, int k, ve
     return count;
 }
 
-int veil__sl_near_box(const veil_grid* g, const veil_opv_light* l, veil__box* out)
+int veil__sl_near_box(const veil_grid* g, const veil_index_light* l, veil__box* out)
 {
     for (int a = 0; a < 3; ++a) {
         out->lo[a] = l->c[a] - 1;
@@ -124,9 +124,9 @@ int veil__sl_near_box(const veil_grid* g, const veil_opv_light* l, veil__box* ou
     return 1;
 }
 
-int veil__sl_sun_axis(const veil_opv_light* l) { return dominant_axis(l->v); }
+int veil__sl_sun_axis(const veil_index_light* l) { return dominant_axis(l->v); }
 
-void veil__sl_sun_slice(const veil_grid* g, const veil_opv_light* l, int k, veil__box* out)
+void veil__sl_sun_slice(const veil_grid* g, const veil_index_light* l, int k, veil__box* out)
 {
     int a = dominant_axis(l->v);
     for (int b = 0; b < 3; ++b) {

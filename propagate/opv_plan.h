@@ -5,6 +5,7 @@
 #define VEIL_OPV_PLAN_H
 
 #include "opv.h"
+#include "opv_blocks.glsl.h"
 
 /* Gather sweep: pass m computes the voxels at up-wind Manhattan distance m.
  * Each pass enumerates the two axes other than `solve` over the grid and
@@ -14,12 +15,12 @@ typedef struct veil__gather_plan {
     int solve;       /* axis solved for */
 } veil__gather_plan;
 
-void veil__gather_plan_make(const veil_grid* g, const veil_opv_light* l, veil__gather_plan* p);
+void veil__gather_plan_make(const veil_grid* g, const veil_index_light* l, veil__gather_plan* p);
 /* Up-wind distance of voxel x along axis a (directional: from the light-facing face). */
-int veil__gather_dist(const veil_grid* g, const veil_opv_light* l, int a, int x);
+int veil__gather_dist(const veil_grid* g, const veil_index_light* l, int a, int x);
 /* The coordinate(s) on `solve` of the shell-m voxels with the other two
  * coordinates given in x (x[solve] ignored); returns how many (0..2). */
-int veil__gather_solve(const veil_grid* g, const veil_opv_light* l, const veil__gather_plan* p, int m,
+int veil__gather_solve(const veil_grid* g, const veil_index_light* l, const veil__gather_plan* p, int m,
                        const int x[3], int out[2]);
 
 /* Semi-Lagrangian, point light: shell s = the voxels with integer
@@ -39,21 +40,21 @@ int veil__gather_solve(const veil_grid* g, const veil_opv_light* l, const veil__
  * |Q_b - S_b| = |e_b| (1 - k/|e_a|) <= |e_a| - k, so the voxels read have
  * distance at most s - k + 1 < s on every axis: all in earlier shells (a
  * path that ends within k voxels is integrated without reading any). */
-#define VEIL_SL_MAX_BOXES 12 /* edges of a cube: the most boxes of a sub-pass */
+/* VEIL_SL_MAX_BOXES (opv_blocks.glsl.h): the edges of a cube, the most boxes of a sub-pass. */
 
 typedef struct veil__box {
     int lo[3], n[3]; /* voxels lo .. lo + n - 1, clipped to the grid */
 } veil__box;
 
 /* Shells s0..s1 (s0 >= 2) that meet the grid. */
-void veil__sl_shell_range(const veil_grid* g, const veil_opv_light* l, int* s0, int* s1);
+void veil__sl_shell_range(const veil_grid* g, const veil_index_light* l, int* s0, int* s1);
 /* The non-empty boxes of sub-pass k (1..3) of shell s; returns the count. */
-int veil__sl_boxes(const veil_grid* g, const veil_opv_light* l, int s, int k, veil__box out[VEIL_SL_MAX_BOXES]);
+int veil__sl_boxes(const veil_grid* g, const veil_index_light* l, int s, int k, veil__box out[VEIL_SL_MAX_BOXES]);
 /* The near field (shells 0 and 1), clipped; returns 0 when empty. */
-int veil__sl_near_box(const veil_grid* g, const veil_opv_light* l, veil__box* out);
+int veil__sl_near_box(const veil_grid* g, const veil_index_light* l, veil__box* out);
 /* Sun: slices along the dominant axis, from the light-facing side. */
-int veil__sl_sun_axis(const veil_opv_light* l);
+int veil__sl_sun_axis(const veil_index_light* l);
 /* The box of slice k (0 = the light-facing side). */
-void veil__sl_sun_slice(const veil_grid* g, const veil_opv_light* l, int k, veil__box* out);
+void veil__sl_sun_slice(const veil_grid* g, const veil_index_light* l, int k, veil__box* out);
 
 #endif

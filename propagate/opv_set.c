@@ -8,12 +8,15 @@
 #include "../core/progress.h"
 #include "../gpu/gl_util.h"
 #include "../gpu/programs.h"
+#include "opv_blocks.glsl.h"
 #include "opv_gpu.h"
 
 struct veil_opv_set {
     veil_opv_programs programs;
     GLuint sparse_program; /* propagate/shaders/propagate_sparse.comp, made when first needed */
     GLuint sun_program;    /* propagate/shaders/sun_prefix.comp, made when first needed */
+    veil_pass_run sparse_run; /* the sparse passes of one light (a veil_sparse_od_block each) */
+    GLuint sun_block;         /* the prefix sums' uniform buffer (veil_sun_block), made with the program */
     GLuint tex[VEIL_MAX_OPV_TEXTURES];
     int dims[VEIL_MAX_OPV_TEXTURES][3];
     GLenum format[VEIL_MAX_OPV_TEXTURES]; /* rgba32f, or r32f for one light on the grid (ordered methods) */
@@ -28,6 +31,7 @@ veil_result veil_opv_set_create(veil_opv_set** out, veil_error* err)
     *out = NULL;
     veil_opv_set* s = calloc(1, sizeof *s);
     if (!s) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the optical-depth volumes");
+    veil_pass_run_init(&s->sparse_run, sizeof(veil_sparse_od_block), "veil sparse optical depth blocks");
     veil_result r = veil_opv_programs_create(&s->programs, err);
     if (r != VEIL_OK) {
         free(s);
@@ -60,6 +64,8 @@ void veil_opv_set_destroy(veil_opv_set* s)
     veil_opv_set_clear(s);
     glDeleteProgram(s->sparse_program);
     glDeleteProgram(s->sun_program);
+    veil_pass_run_free(&s->sparse_run);
+    glDeleteBuffers(1, &s->sun_block);
     veil_opv_programs_destroy(&s->programs);
     free(s);
 }
@@ -81,7 +87,7 @@ static uint64_t params_key(uint64_t key, const veil_opv_params* params)
     return veil_hash_bytes(key, &p, sizeof p);
 }
 
-uint64_t veil_opv_texture_key(uint64_t ev_key, const veil_opv_params* params, const veil_opv_light* lights, int count)
+uint64_t veil_opv_texture_key(uint64_t ev_key, const veil_opv_params* params, const veil_index_light* lights, int count)
 {
     uint64_t key = params_key(ev_key, params);
     for (int c = 0; c < count; ++c) key = veil_hash_bytes(key, &lights[c], sizeof lights[c]);
@@ -112,7 +118,7 @@ static veil_result texture_of(veil_opv_set* s, int t, const int dims[3], GLenum 
  * distance sum |b_a - c_a| (crossing a face towards it takes 1 off; where
  * b_a = c_a the path stays in that slab), from 0 up. So the lowest value
  * goes first either way. */
-static long long level_of(const veil_opv_light* l, const int32_t* b, int sun_sign[3], const int c[3])
+static long long level_of(const veil_index_light* l, const int32_t* b, int sun_sign[3], const int c[3])
 {
     long long v = 0;
     for (int a = 0; a < 3; ++a)
@@ -124,7 +130,7 @@ static long long level_of(const veil_opv_light* l, const int32_t* b, int sun_sig
  * propagate/shaders/propagate_sparse.comp over the kept bricks, level by
  * level (each pass reads only bricks of earlier passes). *passes: the most
  * passes of any light. */
-static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, const veil_opv_light* ol, int count,
+static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, const veil_index_light* ol, int count,
                                  GLuint tex, int* passes, veil_error* err)
 {
     veil_result r = VEIL_OK;
@@ -142,7 +148,9 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
     *passes = 0;
     for (int c = 0; c < count && r == VEIL_OK && n > 0; ++c) {
         /* the light in the sparse index space (opv.h's has voxel i's centre at i, this one at i + 0.5) */
-        float light[4];
+        veil_sparse_od_block blk;
+        memset(&blk, 0, sizeof blk);
+        float* light = blk.light;
         int sign[3], cb[3];
         for (int a = 0; a < 3; ++a) {
             light[a] = ol[c].v[a] + (ol[c].type == VEIL_LIGHT_DIRECTIONAL ? 0.0f : 0.5f);
@@ -151,6 +159,7 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
             cb[a] = cell < -1e9 ? -1000000000 : cell > 1e9 ? 1000000000 : (int)cell;
         }
         light[3] = (float)ol[c].type;
+        blk.pass[0] = c;
         /* counting sort of the slots by level */
         long long lo = 0, hi = 0;
         for (size_t i = 0; i < n; ++i) {
@@ -181,26 +190,35 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
         glDeleteBuffers(1, &buf);
         list_tex = buf = 0;
         r = veil_gl_buffer(list, n * sizeof *list, 0, "veil sparse pass order", &buf, err);
+        /* the light's passes, level by level, each level in dispatches of at most 65535 bricks (GL's
+         * guaranteed work groups per dispatch) */
+        veil_pass_run_clear(&s->sparse_run);
+        for (size_t k = 0; k < levels && r == VEIL_OK; ++k)
+            for (size_t g = 0; g < first[k + 1] - first[k] && r == VEIL_OK; g += 65535) {
+                size_t m = first[k + 1] - first[k] - g;
+                void* mem = NULL;
+                r = veil_pass_run_add(&s->sparse_run, (GLuint)(m < 65535 ? m : 65535), 1, 1, &mem, err);
+                if (r != VEIL_OK) break;
+                veil_sparse_od_block* b = mem;
+                *b = blk;
+                b->pass[1] = (int32_t)(first[k] + g); /* the dispatch's first entry of the list */
+            }
+        if (r == VEIL_OK) r = veil_pass_run_upload(&s->sparse_run, err);
         if (r != VEIL_OK) break;
         glCreateTextures(GL_TEXTURE_BUFFER, 1, &list_tex);
         glTextureBuffer(list_tex, GL_R32I, buf);
         glUseProgram(p);
-        glProgramUniform4fv(p, glGetUniformLocation(p, "u_light"), 1, light);
-        glProgramUniform1i(p, glGetUniformLocation(p, "u_channel"), c);
         veil_ev_sparse_bind(sp);
         glBindTextureUnit(VEIL_TEX_EV, sp->atlas);
         glBindTextureUnit(VEIL_TEX_SPARSE_LIST, list_tex);
         glBindTextureUnit(VEIL_TEX_OPV0, tex);
         glBindImageTexture(VEIL_IMAGE_SPARSE_OUT, tex, 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
         int done = 0;
+        size_t next = 0; /* the run's next dispatch */
         for (size_t k = 0; k < levels; ++k) { /* rank 0, the bricks nearest the light, first */
             size_t m = first[k + 1] - first[k];
             if (!m) continue;
-            glProgramUniform1i(p, glGetUniformLocation(p, "u_first"), (GLint)first[k]);
-            for (size_t g = 0; g < m; g += 65535) { /* GL's guaranteed work groups per dispatch */
-                if (g) glProgramUniform1i(p, glGetUniformLocation(p, "u_first"), (GLint)(first[k] + g));
-                glDispatchCompute((GLuint)(m - g < 65535 ? m - g : 65535), 1, 1);
-            }
+            for (size_t g = 0; g < m; g += 65535) veil_pass_run_dispatch(&s->sparse_run, VEIL_UBO_PROPAGATE, next++);
             glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
             ++done;
         }
@@ -209,6 +227,7 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
         glBindTextureUnit(VEIL_TEX_OPV0, 0);
         glBindTextureUnit(VEIL_TEX_SPARSE_LIST, 0);
         glBindTextureUnit(VEIL_TEX_EV, 0);
+        glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, 0);
         veil_ev_sparse_bind(NULL);
         glUseProgram(0);
         r = veil_gl_check("optical depth over a sparse volume (propagate/shaders/propagate_sparse.comp)", err);
@@ -228,20 +247,26 @@ static veil_result sun_depths(veil_opv_set* s, const veil_grid* g, GLuint ev, GL
                               GLuint tex, veil_error* err)
 {
     veil_result r = VEIL_OK;
-    if (!s->sun_program) r = veil_gpu_program("propagate/shaders/sun_prefix.comp", &s->sun_program, err);
+    if (!s->sun_block)
+        r = veil_gl_buffer(NULL, sizeof(veil_sun_block), GL_DYNAMIC_STORAGE_BIT, "veil light-space block",
+                           &s->sun_block, err);
+    if (r == VEIL_OK && !s->sun_program) r = veil_gpu_program("propagate/shaders/sun_prefix.comp", &s->sun_program, err);
     if (r != VEIL_OK) return r;
-    GLuint p = s->sun_program;
     const float* c = sp->axis[2];
-    glProgramUniform3i(p, glGetUniformLocation(p, "u_dims"), g->dims[0], g->dims[1], g->dims[2]);
-    glProgramUniform3i(p, glGetUniformLocation(p, "u_nodes"), sp->nodes[0], sp->nodes[1], sp->nodes[2]);
-    glProgramUniform3fv(p, glGetUniformLocation(p, "u_origin"), 1, sp->origin);
-    glProgramUniform3fv(p, glGetUniformLocation(p, "u_axis_a"), 1, sp->axis[0]);
-    glProgramUniform3fv(p, glGetUniformLocation(p, "u_axis_b"), 1, sp->axis[1]);
-    glProgramUniform3fv(p, glGetUniformLocation(p, "u_axis_c"), 1, sp->axis[2]);
-    glProgramUniform1i(p, glGetUniformLocation(p, "u_panels"), sp->panels);
-    glProgramUniform1f(p, glGetUniformLocation(p, "u_step"), sqrtf(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) * g->voxel);
-    glProgramUniform1i(p, glGetUniformLocation(p, "u_skip"), occ != 0);
-    glUseProgram(p);
+    veil_sun_block blk;
+    memset(&blk, 0, sizeof blk);
+    for (int a = 0; a < 3; ++a) {
+        blk.dims[a] = g->dims[a];
+        blk.nodes[a] = sp->nodes[a];
+        blk.origin[a] = sp->origin[a];
+        for (int k = 0; k < 3; ++k) blk.axis[k][a] = sp->axis[k][a];
+    }
+    blk.dims[3] = sp->panels;
+    blk.nodes[3] = occ != 0;
+    blk.origin[3] = sqrtf(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) * g->voxel; /* m a step along c */
+    glNamedBufferSubData(s->sun_block, 0, sizeof blk, &blk);
+    glUseProgram(s->sun_program);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, s->sun_block);
     glBindTextureUnit(VEIL_TEX_EV, ev);
     glBindTextureUnit(VEIL_TEX_OCC, occ);
     glBindImageTexture(VEIL_IMAGE_OPV_DST, tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
@@ -250,16 +275,17 @@ static veil_result sun_depths(veil_opv_set* s, const veil_grid* g, GLuint ev, GL
     glBindImageTexture(VEIL_IMAGE_OPV_DST, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
     glBindTextureUnit(VEIL_TEX_EV, 0);
     glBindTextureUnit(VEIL_TEX_OCC, 0);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, 0);
     glUseProgram(0);
     return veil_gl_check("a sun's light-space optical depth (propagate/shaders/sun_prefix.comp)", err);
 }
 
 int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* lights, int n,
-                       const veil_opv_params* params, int max_axis, veil_opv_light* ol, veil_opv_sun* want,
+                       const veil_opv_params* params, int max_axis, veil_index_light* ol, veil_opv_sun* want,
                        uint64_t* want_key)
 {
     int count = 0;
-    for (int l = 0; l < n; ++l) veil_opv_light_from_world(g, &lights[l], &ol[l]);
+    for (int l = 0; l < n; ++l) veil_light_to_index(&lights[l], g->dims, g->origin, g->voxel, &ol[l]);
     if (veil_opv_method_resolve(params->method) != VEIL_OPV_LIGHT_SPACE) return 0;
     int suns = 0; /* the memory allowed is shared by the suns that may get a grid */
     for (int l = 0; l < n && suns < VEIL_MAX_SUNS; ++l) suns += lights[l].type == VEIL_LIGHT_DIRECTIONAL;
@@ -343,7 +369,7 @@ veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, 
     memset(rep, 0, sizeof *rep);
     veil_result r = VEIL_OK;
     const int report = veil_progress_wanted();
-    veil_opv_light ol[VEIL_MAX_LIGHTS];
+    veil_index_light ol[VEIL_MAX_LIGHTS];
     n = n < VEIL_MAX_LIGHTS ? n : VEIL_MAX_LIGHTS;
     veil_opv_sun want[VEIL_MAX_SUNS];
     uint64_t want_key[VEIL_MAX_SUNS];
@@ -399,7 +425,7 @@ veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, 
 }
 
 veil_result veil_opv_set_propagate_readback(veil_opv_set* s, const veil_grid* g, const float* density,
-                                            const veil_opv_light* lights, int n_lights,
+                                            const veil_index_light* lights, int n_lights,
                                             const veil_opv_params* params, float* out, int* iterations,
                                             veil_error* err)
 {

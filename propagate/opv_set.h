@@ -53,7 +53,7 @@ void veil_opv_set_clear(veil_opv_set* s);
 
 /* The key texture t must have to serve these (at most 4) lights of grid g
  * for an EV of key ev_key: a hash of descriptions only. */
-uint64_t veil_opv_texture_key(uint64_t ev_key, const veil_opv_params* params, const veil_opv_light* lights, int count);
+uint64_t veil_opv_texture_key(uint64_t ev_key, const veil_opv_params* params, const veil_index_light* lights, int count);
 
 /* 1 when texture t holds `key` already (the update would reuse it). */
 int veil_opv_set_has(const veil_opv_set* s, int t, uint64_t key);
@@ -77,10 +77,10 @@ GLuint veil_opv_set_texture(const veil_opv_set* s, int t);
  * VEIL_OPV_LIGHT_SPACE): the first VEIL_MAX_SUNS suns whose grid fits
  * max_axis nodes an axis (the GL's 3D texture limit; 0: none fits) and the
  * node budget, the spacing across widened until it does. Fills ol[0..n)
- * (veil_opv_light_from_world, with `elsewhere` set for those), want[] and
+ * (veil_light_to_index, with `elsewhere` set for those), want[] and
  * their keys; returns how many. Needs no GL: veil_plan_explain calls it. */
 int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* lights, int n,
-                       const veil_opv_params* params, int max_axis, veil_opv_light* ol, veil_opv_sun* want,
+                       const veil_opv_params* params, int max_axis, veil_index_light* ol, veil_opv_sun* want,
                        uint64_t* want_key);
 
 /* The light-space grids of the last update (*count of them). */
@@ -96,7 +96,7 @@ veil_result veil_opv_set_sun_readback(veil_opv_set* s, const veil_grid* g, const
  * (n_lights * voxels floats, light-major): tests compare it with the C
  * twin. Leaves the set as it was. */
 veil_result veil_opv_set_propagate_readback(veil_opv_set* s, const veil_grid* g, const float* density,
-                                            const veil_opv_light* lights, int n_lights,
+                                            const veil_index_light* lights, int n_lights,
                                             const veil_opv_params* params, float* out, int* iterations,
                                             veil_error* err);
 

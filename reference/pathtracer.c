@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "../scene/camera.h"
+#include "../scene/light.h"
 #include "pt_internal.h"
 
 /* Russian roulette on the path length: from this vertex on a path goes on
@@ -162,8 +163,7 @@ static void light_at(const pt_job* j, const veil_light* L, const double x[3], co
                 n += (double)L->direction[k] * L->direction[k];
             }
             ca /= sqrt(n);
-            f *= veil_spot_falloff((float)ca, cosf(L->inner_angle_deg * (float)(VEIL_PI / 180.0)),
-                                   cosf(L->outer_angle_deg * (float)(VEIL_PI / 180.0)));
+            f *= veil_spot_falloff((float)ca, veil_light_cos_inner(L), veil_light_cos_outer(L));
         }
     }
     if (!(f > 0.0) || is_dark(L)) return;

@@ -15,6 +15,7 @@
 
 #include "../core/result.h"
 #include "../core/shared.glsl.h"
+#include "light.h"
 #include "particle.h"
 
 #define VEIL_SCENE_DEFAULT_WIDTH 640
@@ -126,22 +127,7 @@ typedef struct veil_medium {
     size_t source_count;
 } veil_medium;
 
-/* VEIL_LIGHT_POINT, VEIL_LIGHT_DIRECTIONAL or VEIL_LIGHT_SPOT (core/shared.glsl.h)
- * (the shaders use the same values); at most VEIL_MAX_LIGHTS lights. */
-typedef int veil_light_type;
-
-typedef struct veil_light {
-    veil_light_type type;
-    float position[3];  /* point, spot: m */
-    float direction[3]; /* directional, spot: unit vector in which light travels (spot: its axis) */
-    float color[3];     /* point, spot: intensity W/sr on the axis; directional: irradiance W/m^2 */
-    /* spot: full intensity within inner_angle_deg of the axis, none beyond
-     * outer_angle_deg, veil_spot_falloff() between; 0 <= inner < outer <= 180 */
-    float inner_angle_deg, outer_angle_deg;
-    /* point: 1/r^2 is floored at radius^2 (m; 0 for a scene's lights: a point;
-     * the medium's emission as lights, volume/emission_lights.h, has a size) */
-    float radius;
-} veil_light;
+/* Lights: veil_light (scene/light.h). */
 
 /* Multiple scattering ("multiple_scattering" in a scene file; see
  * docs/multiple-scattering.md for the derivation and the measurements that

@@ -205,12 +205,20 @@ static veil_result build_occupancy(veil_ev* ev, veil_error* err)
 {
     int b[3];
     for (int a = 0; a < 3; ++a) b[a] = (ev->grid.dims[a] + VEIL_BRICK - 1) / VEIL_BRICK;
+    veil_grid_block blk;
+    memset(&blk, 0, sizeof blk);
+    for (int a = 0; a < 3; ++a) {
+        blk.dims[a] = ev->grid.dims[a];
+        blk.bricks[a] = b[a];
+        blk.origin[a] = ev->grid.origin[a];
+    }
+    blk.origin[3] = ev->grid.voxel;
+    GLuint block = 0;
     veil_result r = veil_gl_texture3d(GL_R32F, b, "veil occupancy bricks", &ev->occ, err);
+    if (r == VEIL_OK) r = veil_gl_buffer(&blk, sizeof blk, 0, "veil occupancy block", &block, err);
     if (r != VEIL_OK) return r;
-    GLuint p = ev->occupancy;
-    glUseProgram(p);
-    glProgramUniform3i(p, glGetUniformLocation(p, "u_dims"), ev->grid.dims[0], ev->grid.dims[1], ev->grid.dims[2]);
-    glProgramUniform3i(p, glGetUniformLocation(p, "u_bricks"), b[0], b[1], b[2]);
+    glUseProgram(ev->occupancy);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_GRID, block);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     glBindImageTexture(VEIL_IMAGE_EV, ev->tex, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32F);
     glBindImageTexture(VEIL_IMAGE_OUT, ev->occ, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
@@ -219,7 +227,9 @@ static veil_result build_occupancy(veil_ev* ev, veil_error* err)
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     glBindImageTexture(VEIL_IMAGE_EV, 0, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32F);
     glBindImageTexture(VEIL_IMAGE_OUT, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+    glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_GRID, 0);
     glUseProgram(0);
+    glDeleteBuffers(1, &block);
     return veil_gl_check("occupancy bricks (volume/shaders/occupancy.comp)", err);
 }
 

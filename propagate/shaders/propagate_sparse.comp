@@ -7,30 +7,30 @@
 // the optical depth that brick already holds (computed in an earlier pass:
 // a brick nearer the light in the pass order, opv_set.c) is read, trilinear
 // on the face it enters (a semi-Lagrangian step a brick long). Or it ends
-// at the light or the box's edge. D in density m, light u_channel's channel.
+// at the light or the box's edge. D in density m, in channel od.pass.x.
 layout(local_size_x = VEIL_SPARSE_APRON, local_size_y = VEIL_SPARSE_APRON, local_size_z = VEIL_SPARSE_APRON) in;
 layout(binding = VEIL_IMAGE_SPARSE_OUT, rgba32f) uniform image3D u_out;
 layout(binding = VEIL_TEX_SPARSE_COORDS) uniform isamplerBuffer u_sp_coords;
 layout(binding = VEIL_TEX_SPARSE_LIST) uniform isamplerBuffer u_list; // slot indices, pass by pass
 layout(binding = VEIL_TEX_OPV0) uniform sampler3D u_depth;            // u_out, sampled: earlier passes' bricks
-// xyz: a point light's position in index coordinates (voxel i's centre at
-// i + 0.5), or a sun's unit direction towards it; w: VEIL_LIGHT_*
-uniform vec4 u_light;
-uniform int u_channel; // 0..3
-uniform int u_first;   // this pass's first entry of u_list
+// od.light: xyz: a point light's position in index coordinates (voxel i's
+// centre at i + 0.5), or a sun's unit direction towards it; w: VEIL_LIGHT_*.
+// od.pass: x: the channel, 0..3; y: this pass's first entry of u_list.
+//@include propagate/opv_blocks.glsl.h
+layout(std140, binding = VEIL_UBO_PROPAGATE) uniform veil_sparse_od_ubo { veil_sparse_od_block od; };
 //@include volume/shaders/sparse_common.glsl
 
 void main()
 {
-    int k = texelFetch(u_list, u_first + int(gl_WorkGroupID.x)).r;
+    int k = texelFetch(u_list, od.pass.y + int(gl_WorkGroupID.x)).r;
     ivec3 j = ivec3(gl_LocalInvocationID);
     ivec3 b = texelFetch(u_sp_coords, k).xyz;
     ivec3 corner = ivec3(k % sp.atlas.x, (k / sp.atlas.x) % sp.atlas.y, k / (sp.atlas.x * sp.atlas.y)) * VEIL_SPARSE_APRON;
     vec3 q = vec3(b * VEIL_BRICK + j) + 0.5;
-    vec3 d = u_light.xyz;
+    vec3 d = od.light.xyz;
     float len = INF;
-    if (int(u_light.w) != VEIL_LIGHT_DIRECTIONAL) {
-        vec3 to = u_light.xyz - q;
+    if (int(od.light.w) != VEIL_LIGHT_DIRECTIONAL) {
+        vec3 to = od.light.xyz - q;
         len = length(to);
         d = len > 0.0 ? to / len : vec3(0.0, 0.0, 1.0);
     }
@@ -47,13 +47,13 @@ void main()
             int region;
             uint slot = sp_slot(nb, region);
             if (slot != 0u) {
-                D += texture(u_depth, sp_atlas_uvw(slot, nb, q + d * t))[u_channel];
+                D += texture(u_depth, sp_atlas_uvw(slot, nb, q + d * t))[od.pass.x];
                 break;
             }
             t += max(sp_region_exit(q + d * t, d, nb, region), ahead);
         }
     }
     vec4 all = imageLoad(u_out, corner + j);
-    all[u_channel] = D;
+    all[od.pass.x] = D;
     imageStore(u_out, corner + j, all);
 }

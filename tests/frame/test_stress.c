@@ -471,8 +471,8 @@ static long check_opv(veil_renderer* r, const veil_scene* s, const veil_grid* g,
 {
     int n = (int)s->light_count;
     if (n == 0) return 0;
-    veil_opv_light ol[VEIL_MAX_LIGHTS];
-    for (int l = 0; l < n; ++l) veil_opv_light_from_world(g, &s->lights[l], &ol[l]);
+    veil_index_light ol[VEIL_MAX_LIGHTS];
+    for (int l = 0; l < n; ++l) veil_light_to_index(&s->lights[l], g->dims, g->origin, g->voxel, &ol[l]);
     float st = 0.0f;
     for (int c = 0; c < 3; ++c) st = fmaxf(st, s->medium.sigma_a[c] + s->medium.sigma_s[c]);
     /* as the renderer: a step changes no tau = sigma_t D by more than the tolerance */

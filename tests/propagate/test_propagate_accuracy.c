@@ -50,8 +50,8 @@ static void test_axis_aligned(void)
             for (int sign = -1; sign <= 1; sign += 2) {
                 veil_light l = {.type = VEIL_LIGHT_DIRECTIONAL};
                 l.direction[axis] = (float)sign; /* travels along +-axis */
-                veil_opv_light ol;
-                veil_opv_light_from_world(&g, &l, &ol);
+                veil_index_light ol;
+                veil_light_to_index(&l, g.dims, g.origin, g.voxel, &ol);
                 veil_opv_params p = {.method = methods[m]};
                 veil_error err = {0};
                 int it = 0;
@@ -98,8 +98,8 @@ static void test_sweep_is_fixed_point(void)
         {.type = VEIL_LIGHT_POINT, .position = {-0.7f, 1.3f, 0.2f}},
         {.type = VEIL_LIGHT_DIRECTIONAL, .direction = {0.48f, -0.8f, 0.36f}},
     };
-    veil_opv_light lights[3];
-    for (int l = 0; l < 3; ++l) veil_opv_light_from_world(&g, &world[l], &lights[l]);
+    veil_index_light lights[3];
+    for (int l = 0; l < 3; ++l) veil_light_to_index(&world[l], g.dims, g.origin, g.voxel, &lights[l]);
     float* a = malloc(3 * nv * sizeof(float));
     float* b = malloc(3 * nv * sizeof(float));
     int it_j = 0, it_s = 0;
@@ -129,8 +129,8 @@ static void test_sl_bound(void)
     const float pos[3][3] = {{0.53f, 0.47f, 0.51f}, {0.3f, 0.71f, 0.45f}, {0.2f, 0.2f, 0.8f}};
     for (int q = 0; q < 3; ++q) {
         veil_light l = {.type = VEIL_LIGHT_POINT, .position = {pos[q][0], pos[q][1], pos[q][2]}};
-        veil_opv_light ol;
-        veil_opv_light_from_world(&g, &l, &ol);
+        veil_index_light ol;
+        veil_light_to_index(&l, g.dims, g.origin, g.voxel, &ol);
         veil_error err = {0};
         int it = 0;
         veil_result res = veil_opv_cpu(
@@ -173,13 +173,13 @@ static void test_far_light(void)
     veil_grid g = {.dims = {8, 8, 8}, .origin = {0, 0, 0}, .voxel = 0.01f};
     for (int s = -1; s <= 1; s += 2) {
         veil_light l = {.type = VEIL_LIGHT_POINT, .position = {s * 1e15f, s * 1e15f, s * 1e15f}, .color = {1, 1, 1}};
-        veil_opv_light ol;
-        veil_opv_light_from_world(&g, &l, &ol);
+        veil_index_light ol;
+        veil_light_to_index(&l, g.dims, g.origin, g.voxel, &ol);
         veil__gather_plan p;
         veil__gather_plan_make(&g, &ol, &p);
         CHECK(p.first > 0 && p.last - p.first == 21, "light at %g: shells %d .. %d", s * 1e15, p.first, p.last);
         for (int a = 0; a < 3; ++a)
-            CHECK(s > 0 ? ol.c[a] == 7 + VEIL_OPV_FAR : ol.c[a] == -VEIL_OPV_FAR, "c[%d] = %d", a, ol.c[a]);
+            CHECK(s > 0 ? ol.c[a] == 7 + VEIL_INDEX_LIGHT_FAR : ol.c[a] == -VEIL_INDEX_LIGHT_FAR, "c[%d] = %d", a, ol.c[a]);
     }
 }
 

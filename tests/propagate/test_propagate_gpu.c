@@ -43,8 +43,8 @@ int main(void)
         {.type = VEIL_LIGHT_DIRECTIONAL, .direction = {0, 0, 1}},
         {.type = VEIL_LIGHT_POINT, .position = {2.0f, -1.0f, 3.0f}},     /* outside, other corner */
     };
-    veil_opv_light lights[5];
-    for (int l = 0; l < 5; ++l) veil_opv_light_from_world(&g, &world[l], &lights[l]);
+    veil_index_light lights[5];
+    for (int l = 0; l < 5; ++l) veil_light_to_index(&world[l], g.dims, g.origin, g.voxel, &lights[l]);
 
     float* cpu = malloc(5 * nv * sizeof(float));
     float* gpu = malloc(5 * nv * sizeof(float));

@@ -28,8 +28,8 @@ int main(void)
     float* D = malloc(nv * sizeof(float));
     for (size_t v = 0; v < nv; ++v) rho[v] = rho0;
     veil_light light = {.type = VEIL_LIGHT_POINT, .position = {(C + 0.5f) / N, (C + 0.5f) / N, (C + 0.5f) / N}};
-    veil_opv_light L;
-    veil_opv_light_from_world(&g, &light, &L);
+    veil_index_light L;
+    veil_light_to_index(&light, g.dims, g.origin, g.voxel, &L);
     CHECK(fabsf(L.v[0] - C) < 1e-5f, "light index position %g", L.v[0]);
 
     veil_opv_params exact = {.method = VEIL_OPV_JACOBI};

@@ -188,7 +188,7 @@ static void test_plan(void)
         lights[l].direction[0] = 0.2f * l - 0.5f, lights[l].direction[1] = -1.0f, lights[l].direction[2] = 0.3f;
         lights[l].color[0] = lights[l].color[1] = lights[l].color[2] = 1.0f;
     }
-    veil_opv_light ol[7];
+    veil_index_light ol[7];
     veil_opv_sun want[VEIL_MAX_SUNS];
     uint64_t keys[VEIL_MAX_SUNS];
     veil_opv_params p = {.method = VEIL_OPV_SEMI_LAGRANGIAN};

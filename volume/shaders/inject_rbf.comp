@@ -16,19 +16,16 @@ layout(std430, binding = VEIL_BIND_BRICK_START) readonly buffer BrickStart { uin
 layout(std430, binding = VEIL_BIND_BRICK_LIST) readonly buffer BrickList { uint brick_list[]; };
 layout(binding = VEIL_IMAGE_EV, r32f) uniform image3D u_ev;
 
-uniform ivec3 u_dims;
-uniform ivec3 u_bricks;
-uniform vec3 u_origin;
-uniform float u_voxel;
-uniform int u_first_z; // this dispatch's first layer of bricks (the splat is split to bound each dispatch's work)
+// gb.dims.w: this dispatch's first layer of bricks (the splat is split to bound each dispatch's work)
+layout(std140, binding = VEIL_UBO_GRID) uniform veil_grid_ubo { veil_grid_block gb; };
 
 void main()
 {
-    ivec3 b = ivec3(gl_WorkGroupID) + ivec3(0, 0, u_first_z);
+    ivec3 b = ivec3(gl_WorkGroupID) + ivec3(0, 0, gb.dims.w);
     ivec3 v = b * VEIL_BRICK + ivec3(gl_LocalInvocationID);
-    if (any(greaterThanEqual(v, u_dims))) return;
-    uint brick = uint((b.z * u_bricks.y + b.y) * u_bricks.x + b.x);
-    precise vec3 x = u_origin + (vec3(v) + 0.5) * u_voxel;
+    if (any(greaterThanEqual(v, gb.dims.xyz))) return;
+    uint brick = uint((b.z * gb.bricks.y + b.y) * gb.bricks.x + b.x);
+    precise vec3 x = gb.origin.xyz + (vec3(v) + 0.5) * gb.origin.w;
     precise float sum = imageLoad(u_ev, v).r;
     uint end = brick_start[brick + 1u];
     for (uint e = brick_start[brick]; e < end; ++e) {

@@ -8,15 +8,14 @@ layout(local_size_x = VEIL_OCCUPANCY_GROUP, local_size_y = VEIL_OCCUPANCY_GROUP,
 layout(binding = VEIL_IMAGE_EV, r32f) readonly uniform image3D u_ev;
 layout(binding = VEIL_IMAGE_OUT, r32f) writeonly uniform image3D u_occ;
 
-uniform ivec3 u_dims;   // voxels
-uniform ivec3 u_bricks; // bricks
+layout(std140, binding = VEIL_UBO_GRID) uniform veil_grid_ubo { veil_grid_block gb; }; // dims, bricks
 
 void main()
 {
     ivec3 b = ivec3(gl_GlobalInvocationID);
-    if (any(greaterThanEqual(b, u_bricks))) return;
+    if (any(greaterThanEqual(b, gb.bricks.xyz))) return;
     ivec3 lo = max(b * VEIL_BRICK - 1, ivec3(0));
-    ivec3 hi = min(b * VEIL_BRICK + VEIL_BRICK, u_dims - 1);
+    ivec3 hi = min(b * VEIL_BRICK + VEIL_BRICK, gb.dims.xyz - 1);
     float m = 0.0;
     for (int z = lo.z; z <= hi.z; ++z)
         for (int y = lo.y; y <= hi.y; ++y)
