@@ -172,7 +172,7 @@ VEIL_STRUCT_BEGIN(veil_march_block)
     VEIL_V4(background);   /* rgb: radiance behind the medium */
     VEIL_V4(march);        /* x: step (m); yzw: - */
     VEIL_V4(limits);       /* x: no step starts at or beyond this distance (m; 3e38: no limit) */
-    VEIL_IV4(size);        /* x, y: image size (pixels) */
+    VEIL_IV4(size);        /* x, y: image size (pixels); z: the first row of this dispatch's band */
     VEIL_UV4(flags);       /* x: -, y: skip empty bricks, z: jitter seed, w: per-pixel end */
     VEIL_V4(octave);       /* volumetric multiple scattering: x: a, y: b, z: c, w: octaves (0: off) */
     VEIL_V4(diffusion);    /* xyz: the volumetric field's texture origin (m); w: its veil_field_kind */

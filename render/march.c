@@ -1,6 +1,7 @@
 #include "march.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -173,14 +174,14 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         glBindTextureUnit(VEIL_TEX_DIFFUSION, d->field ? d->field->texture : 0);
         glBindTextureUnit(VEIL_TEX_EMISSION, lm->grid ? lm->emission : 0);
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], tex[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        const GLuint program = lm->grid && lm->sparse ? m->program_sparse[lm->emission != 0]
-                               : lm->grid && lm->emission ? m->program_emission : m->program;
-        const GLint first_row = glGetUniformLocation(program, "u_first_row");
         const int band = veil_march_band_rows(d, w, h);
         const int report = veil_progress_wanted();
         if (report) veil_progress("march, rows", 0, h);
         for (int y = 0; y < h; y += band) {
-            glProgramUniform1i(program, first_row, y);
+            if (y > 0) { /* the band's first row: size.z of the march's block (uploaded with 0) */
+                u.size[2] = y;
+                glNamedBufferSubData(m->ubo, offsetof(veil_march_block, size), sizeof u.size, u.size);
+            }
             glDispatchCompute(veil_groups(w, VEIL_MARCH_GROUP), veil_groups(h - y < band ? h - y : band, VEIL_MARCH_GROUP), 1);
             if (report) { /* what is reported is done */
                 glFinish();

@@ -53,7 +53,6 @@ layout(binding = VEIL_TEX_OCC) uniform sampler3D u_occ; // max density per VEIL_
 layout(binding = VEIL_TEX_LIMIT) uniform sampler2D u_limit; // u.flags.w: distance (m) where each pixel's ray ends
 layout(binding = VEIL_TEX_DIFFUSION) uniform sampler3D u_phi; // u.diffusion.w: multiply scattered fluence (W/m^2)
 layout(binding = VEIL_TEX_EMISSION) uniform sampler3D u_emission; // med.shape.w: emission eps (W m^-3 sr^-1)
-uniform int u_first_row; // the first row of this dispatch's band
 layout(std140, binding = VEIL_UBO_MARCH) uniform veil_march_ubo { veil_march_block u; };
 //@include propagate/shaders/lit_medium.glsl
 
@@ -136,7 +135,7 @@ float nearest_light(vec3 x)
 
 void main()
 {
-    ivec2 p = ivec2(gl_GlobalInvocationID.xy) + ivec2(0, u_first_row); // a band of rows (render/march.h)
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy) + ivec2(0, u.size.z); // a band of rows (render/march.h)
     if (any(greaterThanEqual(p, u.size.xy))) return;
     vec2 s = vec2(2.0 * (float(p.x) + 0.5) / float(u.size.xy.x) - 1.0,
                   1.0 - 2.0 * (float(p.y) + 0.5) / float(u.size.xy.y));
