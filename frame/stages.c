@@ -84,13 +84,17 @@ int veil_render_lights(const veil_scene* s, const veil_grid* g, veil_light* out)
     return n;
 }
 
-veil_opv_params veil_render_opv_params(const veil_scene* s, const veil_render_opts* o, const veil_grid* g,
-                                       unsigned long long budget)
+/* The propagation parameters for s under resolved options o: the method,
+ * the light-space spacing, the Jacobi tolerance on D that keeps sigma_t D
+ * within VEIL_OPV_TAU_TOLERANCE, and (grid g, a device budget of `budget`
+ * bytes; NULL or 0: none) the memory left for the suns' grids. */
+static veil_opv_params opv_params(const veil_scene* s, const veil_render_opts* o, const veil_grid* g,
+                                  unsigned long long budget)
 {
     float st_max = 0.0f;
     for (int c = 0; c < 3; ++c) st_max = fmaxf(st_max, s->medium.sigma_a[c] + s->medium.sigma_s[c]);
     /* D changes of tol move tau by at most st_max * tol */
-    veil_opv_params p = {.method = veil_opv_method_resolve(o->method),
+    veil_opv_params p = {.method = o->method,
                          .tolerance = st_max > 0.0f ? VEIL_OPV_TAU_TOLERANCE / st_max : INFINITY,
                          .sun_across = o->sun_across, .sun_along = o->sun_along};
     if (g && budget > 0) {
@@ -135,7 +139,12 @@ void veil_frame_plan_volume(veil_frame_plan* p, const veil_grid* g, int sparse, 
     if (n_emission > VEIL_MAX_LIGHTS - p->light_count) n_emission = VEIL_MAX_LIGHTS - p->light_count;
     for (int i = 0; i < n_emission; ++i) p->lights[p->light_count++] = emission[i];
     p->emission_lights = n_emission > 0 ? n_emission : 0;
-    p->opv = veil_render_opv_params(p->scene, &p->o, g, p->budget);
+    p->opv = opv_params(p->scene, &p->o, g, p->budget);
+    /* the GL's 3D textures reach at least VEIL_GL_MIN_3D_TEXTURE texels an axis; a device may allow more */
+    p->sun_count = g ? veil_opv_plan_suns(g, p->ev_key, p->lights, p->light_count, &p->opv,
+                                          p->sparse ? 0 : VEIL_GL_MIN_3D_TEXTURE, p->index_lights, p->suns,
+                                          p->sun_keys)
+                     : 0;
     const veil_multiple* m = &p->scene->multiple;
     p->volumetric = (veil_volumetric_desc){
         .kind = field_kind(m),
@@ -314,12 +323,7 @@ static uint64_t propagate_key(const veil_frame_plan* p)
     veil_opv_params keyed = p->opv;
     keyed.sun_bytes = 0.0; /* as the textures' keys: the allowance shows through the grids it makes */
     uint64_t key = veil_hash_bytes(p->ev_key, &keyed, sizeof keyed);
-    for (int l = 0; l < p->light_count; ++l) {
-        veil_index_light ol;
-        veil_light_to_index(&p->lights[l], p->grid->dims, p->grid->origin, p->grid->voxel, &ol);
-        key = veil_hash_bytes(key, &ol, sizeof ol);
-    }
-    return key;
+    return veil_hash_bytes(key, p->index_lights, (size_t)p->light_count * sizeof *p->index_lights);
 }
 
 static const char* propagate_method(const veil_frame_plan* p)
@@ -342,13 +346,11 @@ static veil_stage_status propagate_decide(const veil_frame_plan* p, int kept, ch
             propagate_method(p));
         return VEIL_STAGE_CACHED;
     }
-    /* the textures and light-space grids it will make (the GL's 3D textures reach at least
-     * VEIL_GL_MIN_3D_TEXTURE texels an axis; a device may allow more) */
-    veil_index_light ol[VEIL_MAX_LIGHTS];
-    veil_opv_sun suns[VEIL_MAX_SUNS];
-    uint64_t sun_keys[VEIL_MAX_SUNS];
-    int n_suns = veil_opv_plan_suns(p->grid, p->ev_key, p->lights, p->light_count, &p->opv,
-                                    p->sparse ? 0 : VEIL_GL_MIN_3D_TEXTURE, ol, suns, sun_keys);
+    /* the textures and light-space grids it will make */
+    const veil_index_light* ol = p->index_lights;
+    const veil_opv_sun* suns = p->suns;
+    const uint64_t* sun_keys = p->sun_keys;
+    const int n_suns = p->sun_count;
     int textures = 0;
     for (int tex = 0; 4 * tex < p->light_count; ++tex) {
         int count = p->light_count - 4 * tex < 4 ? p->light_count - 4 * tex : 4, on_grid = 0;

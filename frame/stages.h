@@ -29,6 +29,7 @@
 
 #include "../core/result.h"
 #include "../propagate/opv.h"
+#include "../propagate/opv_set.h"
 #include "../render/image_set.h"
 #include "../scene/scene.h"
 #include "../volume/volume.h"
@@ -81,13 +82,6 @@ const veil_quality_rung* veil_quality_rung_of(veil_quality q); /* UNSET: the def
  * does; a spot whose outer cone misses the box's bounding sphere does not. */
 int veil_render_lights(const veil_scene* s, const veil_grid* g, veil_light* out);
 
-/* The propagation parameters for s under resolved options o: the method,
- * the light-space spacing, the Jacobi tolerance on D that keeps sigma_t D
- * within VEIL_OPV_TAU_TOLERANCE, and (grid g, a device budget of `budget`
- * bytes; NULL or 0: none) the memory left for the suns' grids. */
-veil_opv_params veil_render_opv_params(const veil_scene* s, const veil_render_opts* o, const veil_grid* g,
-                                       unsigned long long budget);
-
 /* A frame's plan: every setting resolved once, read by every row. */
 typedef struct veil_frame_plan {
     const veil_scene* scene;
@@ -109,6 +103,12 @@ typedef struct veil_frame_plan {
     veil_light lights[VEIL_MAX_LIGHTS];
     int light_count, emission_lights;
     veil_opv_params opv;            /* the propagation's method and parameters */
+    /* the lights in the grid's index space, and the suns that get a light-space grid (as planned
+     * without a device: at most VEIL_GL_MIN_3D_TEXTURE nodes an axis; propagate/opv_set.h) */
+    veil_index_light index_lights[VEIL_MAX_LIGHTS];
+    veil_opv_sun suns[VEIL_MAX_SUNS];
+    uint64_t sun_keys[VEIL_MAX_SUNS];
+    int sun_count;
     veil_volumetric_desc volumetric; /* its kind (VEIL_FIELD_NONE: no field wanted) and grid settings */
 } veil_frame_plan;
 

@@ -56,6 +56,12 @@ typedef enum veil_opv_method {
 /* The default, chosen from the measurements in docs/performance.md. */
 #define VEIL_OPV_DEFAULT_METHOD VEIL_OPV_LIGHT_SPACE
 
+/* The default made explicit. A frame resolves it once, in its plan
+ * (frame/stages.h, veil_render_opts_resolve); inside propagate/ a method is
+ * always resolved already (veil_opv_set_update and veil_opv_gpu refuse
+ * VEIL_OPV_DEFAULT), except at the two doors tests and benchmarks use
+ * directly, veil_opv_cpu and veil_opv_set_propagate_readback, which
+ * resolve it themselves. */
 static inline veil_opv_method veil_opv_method_resolve(veil_opv_method m)
 {
     return m == VEIL_OPV_DEFAULT ? VEIL_OPV_DEFAULT_METHOD : m;

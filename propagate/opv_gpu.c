@@ -193,10 +193,12 @@ veil_result veil_opv_gpu(veil_opv_programs* p, const veil_grid* g, GLuint ev, co
 {
     int most = 0;
     veil_result r = VEIL_OK;
-    veil_opv_params resolved = *params;
-    resolved.method = veil_opv_method_resolve(params->method);
-    if (resolved.method == VEIL_OPV_LIGHT_SPACE) resolved.method = VEIL_OPV_SEMI_LAGRANGIAN; /* on the grid */
-    params = &resolved;
+    if (params->method <= VEIL_OPV_DEFAULT || params->method >= VEIL_OPV_METHOD_COUNT)
+        return veil_fail(err, VEIL_ERR_INVALID, "propagate: method %d is not a resolved method (veil_opv_method_resolve)",
+                         (int)params->method);
+    veil_opv_params on_grid = *params;
+    if (on_grid.method == VEIL_OPV_LIGHT_SPACE) on_grid.method = VEIL_OPV_SEMI_LAGRANGIAN; /* a sun kept on the grid */
+    params = &on_grid;
     glBindImageTexture(VEIL_IMAGE_EV, ev, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32F);
     if (params->method == VEIL_OPV_JACOBI || params->method == VEIL_OPV_JACOBI_CORRECTED) {
         r = run_jacobi(p, g, lights, n_lights, params, opv, &most, err);

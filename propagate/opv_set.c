@@ -286,7 +286,7 @@ int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* li
 {
     int count = 0;
     for (int l = 0; l < n; ++l) veil_light_to_index(&lights[l], g->dims, g->origin, g->voxel, &ol[l]);
-    if (veil_opv_method_resolve(params->method) != VEIL_OPV_LIGHT_SPACE) return 0;
+    if (params->method != VEIL_OPV_LIGHT_SPACE) return 0;
     int suns = 0; /* the memory allowed is shared by the suns that may get a grid */
     for (int l = 0; l < n && suns < VEIL_MAX_SUNS; ++l) suns += lights[l].type == VEIL_LIGHT_DIRECTIONAL;
     for (int l = 0; l < n && count < VEIL_MAX_SUNS; ++l) {
@@ -367,6 +367,9 @@ veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, 
                                 const veil_opv_params* params, veil_opv_report* rep, veil_error* err)
 {
     memset(rep, 0, sizeof *rep);
+    if (params->method <= VEIL_OPV_DEFAULT || params->method >= VEIL_OPV_METHOD_COUNT)
+        return veil_fail(err, VEIL_ERR_INVALID, "propagate: method %d is not a resolved method (veil_opv_method_resolve)",
+                         (int)params->method);
     veil_result r = VEIL_OK;
     const int report = veil_progress_wanted();
     veil_index_light ol[VEIL_MAX_LIGHTS];
@@ -399,7 +402,7 @@ veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, 
         }
         const int* td = sp ? sp->atlas_texels : g->dims;
         /* one light on the grid by an ordered method: r32f (the march reads channel 0 either way) */
-        veil_opv_method m = veil_opv_method_resolve(params->method);
+        veil_opv_method m = params->method;
         int one = !sp && on_grid == 1 && count == 1 && m != VEIL_OPV_JACOBI && m != VEIL_OPV_JACOBI_CORRECTED;
         rep->mib += (double)td[0] * td[1] * td[2] * (one ? 4.0 : 16.0) / 1048576.0;
         uint64_t key = veil_opv_texture_key(ev_key, params, ol + 4 * t, count);
@@ -441,8 +444,12 @@ veil_result veil_opv_set_propagate_readback(veil_opv_set* s, const veil_grid* g,
         glTextureSubImage3D(ev, 0, 0, 0, 0, g->dims[0], g->dims[1], g->dims[2], GL_RED, GL_FLOAT, density);
         r = veil_gl_check("uploading the extinction volume", err);
     }
+    /* a door for tests and benchmarks: the method is resolved here, as the frame's plan does */
+    veil_opv_params resolved = *params;
+    resolved.method = veil_opv_method_resolve(params->method);
+    params = &resolved;
     /* as veil_opv_set_update makes them: a texture of one light is r32f for the ordered methods */
-    veil_opv_method m = veil_opv_method_resolve(params->method);
+    veil_opv_method m = params->method;
     int ordered = m != VEIL_OPV_JACOBI && m != VEIL_OPV_JACOBI_CORRECTED;
     for (int t = 0; t < n_tex && r == VEIL_OK; ++t) {
         int one = ordered && n_lights - 4 * t == 1;
