@@ -90,56 +90,94 @@ static void explain_lights(text* t, const veil_frame_plan* p)
     }
 }
 
+/* Opens the volume as the files' headers describe it (no density reaches a GPU) into f's plan. */
+static veil_result plan_open(veil_frame* f, const veil_scene* s, const veil_render_opts* opts, veil_scene_volume* v,
+                             veil_error* err)
+{
+    memset(f, 0, sizeof *f);
+    memset(v, 0, sizeof *v);
+    veil_frame_plan* p = &f->plan;
+    veil_frame_plan_begin(p, s, opts, 0); /* no device here: no memory budget */
+    veil_result r = p->volume_needed ? veil_scene_volume_open(s, v, err) : VEIL_OK;
+    if (r != VEIL_OK) return r;
+    p->grid = v->has_volume ? &v->grid : NULL;
+    p->sparse = v->sparse;
+    p->particles = v->particle_count;
+    p->vdb_voxels = v->vdb_voxels;
+    p->resolution = p->volume_needed ? v->resolution : NULL;
+    p->emission_possible = p->grid && v->emission_count > 0 && s->multiple.emission_lights > 0;
+    return VEIL_OK;
+}
+
+/* The walk: each row's key and decision on the first frame (nothing kept)
+ * and on the later ones (the first frame's results kept), as
+ * frame/renderer.c makes them; `why` of size n per report; t (NULL: none)
+ * gets the text of --explain. */
+static void walk(veil_frame* f, veil_stage_report* first, veil_stage_report* later, char* why, size_t n, long frames,
+                 text* t)
+{
+    veil_frame_plan* p = &f->plan;
+    for (int i = 0; i < VEIL_STAGE_COUNT; ++i) {
+        const veil_stage_row* row = &veil_stage_table[i];
+        const char* name = veil_stage_name(row->id);
+        veil_stage_report* a = &first[row->id];
+        veil_stage_report* b = &later[row->id];
+        a->key = b->key = row->key(p);
+        a->status = row->decide(p, 0, why, n);
+        snprintf(a->why, sizeof a->why, "%s", why);
+        if (t && a->status == VEIL_STAGE_SKIPPED)
+            put(t, "%-10s skipped on every frame: %s\n", name, why);
+        else if (t && row->per_view)
+            put(t, "%-10s every frame: runs, %s\n", name, why);
+        else if (t)
+            put(t, "%-10s frame 0: runs, %s\n", name, why);
+        /* the frames after the first find the first's results kept (a stage that was skipped keeps
+         * nothing: it is skipped again; one that depends on the camera runs again) */
+        b->status = row->decide(p, a->status != VEIL_STAGE_SKIPPED && !row->per_view, why, n);
+        snprintf(b->why, sizeof b->why, "%s", why);
+        if (t && frames > 1 && a->status == VEIL_STAGE_RAN && !row->per_view) {
+            put(t, "           ");
+            later_frames(t, frames);
+            put(t, ": %s (%s; the key holds no camera)\n", veil_stage_status_name(b->status), why);
+        }
+        if (row->settle) row->settle(f, a);
+        if (t && row->id == VEIL_STAGE_INJECT) explain_lights(t, p);
+    }
+}
+
+veil_result veil_plan_reports(const veil_scene* s, const veil_render_opts* opts, veil_stage_report* first,
+                              veil_stage_report* later, veil_error* err)
+{
+    veil_frame f;
+    veil_scene_volume v;
+    veil_result r = plan_open(&f, s, opts, &v, err);
+    if (r == VEIL_OK) {
+        char why[VEIL_STAGE_WHY_MAX];
+        walk(&f, first, later, why, sizeof why, 2, NULL);
+    }
+    veil_scene_volume_close(&v);
+    return r;
+}
+
 veil_result veil_plan_explain(const veil_scene* s, const veil_render_opts* opts, long frames, char** out,
                               veil_error* err)
 {
     *out = NULL;
     if (frames < 1) return veil_fail(err, VEIL_ERR_INVALID, "explain: %ld frames (at least 1)", frames);
     veil_frame f;
-    memset(&f, 0, sizeof f);
-    veil_frame_plan* p = &f.plan;
-    veil_frame_plan_begin(p, s, opts, 0); /* no device here: no memory budget */
-    text t = {0};
-    put(&t, "plan: %s, %ld frame%s of %dx%d%s\n", s->path ? s->path : "<scene>", frames, frames == 1 ? "" : "s",
-        p->o.width, p->o.height, frames > 1 ? ", camera orbiting the look-at point (scene/camera.h)" : "");
-    /* the volume as the files' headers describe it (no density is read into a GPU) */
     veil_scene_volume v;
-    memset(&v, 0, sizeof v);
-    veil_result r = p->volume_needed ? veil_scene_volume_open(s, &v, err) : VEIL_OK;
+    veil_result r = plan_open(&f, s, opts, &v, err);
     if (r != VEIL_OK) {
-        free(t.s);
+        veil_scene_volume_close(&v);
         return r;
     }
-    p->grid = v.has_volume ? &v.grid : NULL;
-    p->sparse = v.sparse;
-    p->particles = v.particle_count;
-    p->vdb_voxels = v.vdb_voxels;
-    p->resolution = p->volume_needed ? v.resolution : NULL;
-    p->emission_possible = p->grid && v.emission_count > 0 && s->multiple.emission_lights > 0;
-
+    text t = {0};
+    put(&t, "plan: %s, %ld frame%s of %dx%d%s\n", s->path ? s->path : "<scene>", frames, frames == 1 ? "" : "s",
+        f.plan.o.width, f.plan.o.height, frames > 1 ? ", camera orbiting the look-at point (scene/camera.h)" : "");
     /* the same table, the same keys and decisions as a render (frame/stages.h) */
     char why[4096];
-    for (int i = 0; i < VEIL_STAGE_COUNT; ++i) {
-        const veil_stage_row* row = &veil_stage_table[i];
-        const char* name = veil_stage_name(row->id);
-        veil_stage_report rep = {.key = row->key(p)};
-        rep.status = row->decide(p, 0, why, sizeof why);
-        if (rep.status == VEIL_STAGE_SKIPPED)
-            put(&t, "%-10s skipped on every frame: %s\n", name, why);
-        else if (row->per_view)
-            put(&t, "%-10s every frame: runs, %s\n", name, why);
-        else {
-            put(&t, "%-10s frame 0: runs, %s\n", name, why);
-            if (frames > 1) {
-                row->decide(p, 1, why, sizeof why); /* what the next frames find kept */
-                put(&t, "           ");
-                later_frames(&t, frames);
-                put(&t, ": cached (%s; the key holds no camera)\n", why);
-            }
-        }
-        if (row->settle) row->settle(&f, &rep);
-        if (row->id == VEIL_STAGE_INJECT) explain_lights(&t, p);
-    }
+    veil_stage_report first[VEIL_STAGE_COUNT], later[VEIL_STAGE_COUNT];
+    walk(&f, first, later, why, sizeof why, frames, &t);
     veil_scene_volume_close(&v);
     if (t.oom) {
         free(t.s);

@@ -22,6 +22,15 @@
 veil_result veil_plan_explain(const veil_scene* s, const veil_render_opts* opts, long frames, char** text,
                               veil_error* err);
 
+/* The same walk as data: each stage's key, status and why (cut to
+ * VEIL_STAGE_WHY_MAX) on the first frame of a run (`first`) and on the
+ * frames after it (`later`), VEIL_STAGE_COUNT reports each, ms 0. What
+ * frame/renderer.c reports for those frames, stage by stage, except where
+ * a build learns what no description says (a view found optically thin,
+ * sources that hold no density, the emission's lights). */
+veil_result veil_plan_reports(const veil_scene* s, const veil_render_opts* opts, veil_stage_report* first,
+                              veil_stage_report* later, veil_error* err);
+
 /* The file of frame `frame`: `path` itself when !numbered, else its stem,
  * "_", the frame number with at least 4 digits, and its extension
  * ("out/t.exr", 7 -> "out/t_0007.exr"). VEIL_ERR_LIMIT when it does not

@@ -215,6 +215,10 @@ static uint64_t inject_key(const veil_frame_plan* p)
 
 static veil_stage_status inject_decide(const veil_frame_plan* p, int kept, char* w, size_t n)
 {
+    if (!p->volume_needed) { /* nothing to make, so nothing kept either: skipped on every frame */
+        say(w, n, "no voxelised source%s", p->fogs ? " (analytic fog only: closed form)" : "");
+        return VEIL_STAGE_SKIPPED;
+    }
     if (kept) {
         say(w, n, "%s", p->given_grid ? "the same density on the same grid"
                                       : "the sources' descriptions and files are unchanged");
@@ -224,10 +228,6 @@ static veil_stage_status inject_decide(const veil_frame_plan* p, int kept, char*
         const int* d = p->given_grid->dims;
         say(w, n, "a density given on a %dx%dx%d grid", d[0], d[1], d[2]);
         return VEIL_STAGE_RAN;
-    }
-    if (!p->volume_needed) {
-        say(w, n, "no voxelised source%s", p->fogs ? " (analytic fog only: closed form)" : "");
-        return VEIL_STAGE_SKIPPED;
     }
     if (p->resolution && !p->grid) { /* explaining: the files hold nothing */
         say(w, n, "the sources hold no density (no particle, no active voxel)");
@@ -457,16 +457,18 @@ static veil_stage_status volumetric_decide(const veil_frame_plan* p, int kept, c
         say(w, n, "the volume, lights and medium are unchanged");
         return VEIL_STAGE_CACHED;
     }
+    const unsigned long long key = (unsigned long long)volumetric_key(p);
     if (escape && p->sparse)
-        say(w, n, "the octaves' escape field, %d points a kept brick (every %.4g m): view- and light-independent, "
-            "kept", VEIL_SPARSE_ESCAPE * VEIL_SPARSE_ESCAPE * VEIL_SPARSE_ESCAPE,
+        say(w, n, "key %016llx: the octaves' escape field, %d points a kept brick (every %.4g m): view- and "
+            "light-independent, kept", key, VEIL_SPARSE_ESCAPE * VEIL_SPARSE_ESCAPE * VEIL_SPARSE_ESCAPE,
             (double)VEIL_BRICK / (VEIL_SPARSE_ESCAPE - 1) * p->grid->voxel);
     else if (escape)
-        say(w, n, "the octaves' escape field, %dx%dx%d cells of %.4g m: view- and light-independent, kept", dims[0],
-            dims[1], dims[2], cell);
+        say(w, n, "key %016llx: the octaves' escape field, %dx%dx%d cells of %.4g m: view- and light-independent, "
+            "kept", key, dims[0], dims[1], dims[2], cell);
     else
-        say(w, n, "%dx%dx%d cells of %.4g m, %d red-black sweeps: view-independent, kept for the next frames", dims[0],
-            dims[1], dims[2], cell, veil_volumetric_sweeps(&dd, dims));
+        say(w, n, "key %016llx: the diffusion fluence, %dx%dx%d cells of %.4g m, %d red-black sweeps: "
+            "view-independent, kept for the next frames", key, dims[0], dims[1], dims[2], cell,
+            veil_volumetric_sweeps(&dd, dims));
     return VEIL_STAGE_RAN;
 }
 
