@@ -51,11 +51,14 @@ veil_result veil_frame_pattern_path(const char* pattern, long frame, char* out, 
     int fits = 1;
     for (size_t i = 0; pattern[i] && fits; ++i) {
         if (i == at) {
-            char num[32];
-            int w = frame < 0 ? snprintf(num, sizeof num, "-%0*ld", digits, -frame)
-                              : snprintf(num, sizeof num, "%0*ld", digits, frame);
+            /* written straight into out, its length asked first: the pattern's run of # sets the least
+             * digits and may be longer than any buffer of its own (a fixed one overflowed at 32 #);
+             * the magnitude as unsigned, so that -LONG_MIN does not overflow */
+            unsigned long mag = frame < 0 ? 0UL - (unsigned long)frame : (unsigned long)frame;
+            const char* sign = frame < 0 ? "-" : "";
+            int w = snprintf(NULL, 0, "%s%0*lu", sign, digits, mag);
             if (w < 0 || k + (size_t)w >= n) fits = 0;
-            else memcpy(out + k, num, (size_t)w), k += (size_t)w;
+            else snprintf(out + k, n - k, "%s%0*lu", sign, digits, mag), k += (size_t)w;
             i += len - 1;
             continue;
         }

@@ -8,6 +8,7 @@
  * image's centre and each pixel's ray through its centre (float
  * arithmetic on coordinates of magnitude <= 10: 1e-5 of the image), and
  * they, the frame and the strings read back as written, bit for bit. */
+#include <limits.h>
 #include <math.h>
 #include <string.h>
 
@@ -64,6 +65,20 @@ static void test_patterns(void)
     }
     char tiny[8];
     CHECK(veil_frame_pattern_path("long.####.exr", 1, tiny, sizeof tiny, &err) == VEIL_ERR_LIMIT, "too long a name");
+    /* a run of # longer than any number (issue 22: 32 or more # overflowed a 32-byte buffer, found by
+     * fuzz_scene): 40 digits, zero-padded, whole; in a buffer too small for them, refused */
+    char pat[64], want[64], big[128];
+    snprintf(pat, sizeof pat, "f.%s.exr", "########################################");
+    snprintf(want, sizeof want, "f.%s7.exr", "000000000000000000000000000000000000000");
+    CHECK(veil_frame_pattern_path(pat, 7, big, sizeof big, &err) == VEIL_OK && !strcmp(big, want),
+          "40 #: '%s' (want '%s')", big, want);
+    char mid[32];
+    CHECK(veil_frame_pattern_path(pat, 7, mid, sizeof mid, &err) == VEIL_ERR_LIMIT, "40 # in 32 bytes accepted");
+    /* the most negative frame: its magnitude does not fit a long */
+    char lmin[64];
+    snprintf(lmin, sizeof lmin, "f.-%lu.exr", 0UL - (unsigned long)LONG_MIN);
+    CHECK(veil_frame_pattern_path("f.#.exr", LONG_MIN, big, sizeof big, &err) == VEIL_OK && !strcmp(big, lmin),
+          "LONG_MIN: '%s' (want '%s')", big, lmin);
 }
 
 static double dist(const float a[3], const float b[3])
