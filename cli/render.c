@@ -114,6 +114,17 @@ int veil_cmd_render(int argc, char** argv)
     const char* names[2] = {"-o", "--png"};
     rc = veil_cli_check_outputs(ins, 1, outs, names, 2);
     if (rc != EXIT_OK) return rc;
+    /* --turntable N writes OUT_0000.exr ...: every frame's files, not only the names given, are checked
+     * against the scene and each other before any work (issue 22: s_0001.json was overwritten) */
+    for (long f = 0; a.frames > 0 && f < a.frames; ++f) {
+        char fe[4096], fp[4096];
+        veil_result fr = veil_frame_path(a.exr, f, 1, fe, sizeof fe, &err);
+        if (fr == VEIL_OK && a.png) fr = veil_frame_path(a.png, f, 1, fp, sizeof fp, &err);
+        if (fr != VEIL_OK) return veil_cli_fail(fr, &err);
+        const char* fouts[2] = {fe, a.png ? fp : NULL};
+        rc = veil_cli_check_outputs(ins, 1, fouts, names, 2);
+        if (rc != EXIT_OK) return rc;
+    }
     veil_result r = veil_cli_check_output_folder(a.exr, &err);
     if (r == VEIL_OK && a.png) r = veil_cli_check_output_folder(a.png, &err);
     if (r != VEIL_OK) return veil_cli_fail(r, &err);

@@ -227,7 +227,27 @@ int veil_cmd_turntable(int argc, char** argv)
         if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
         return r == VEIL_OK ? EXIT_OK : veil_cli_fail(r, &err);
     }
-    /* the first frame's files stand for all: folders exist, no output is the scene or the other output */
+    /* every frame of this run: no file of it is the scene, and a frame's EXR is never its PNG (issue 22:
+     * -o 'f#.exr' --png 'f##.exr' made frame 10's two files one; 's#.json' overwrote s2.json) */
+    for (long i = a.shard - 1; i < count; i += a.shards) {
+        long frame = veil_frame_range_at(&a.range, i);
+        char fe[4096], fp[4096];
+        r = veil_frame_pattern_path(a.exr, frame, fe, sizeof fe, &err);
+        if (r == VEIL_OK && a.png) r = veil_frame_pattern_path(a.png, frame, fp, sizeof fp, &err);
+        if (r != VEIL_OK) {
+            veil_scene_free(&scene);
+            return veil_cli_fail(r, &err);
+        }
+        const char* ins[1] = {a.scene};
+        const char* outs[2] = {fe, a.png ? fp : NULL};
+        const char* names[2] = {"-o", "--png"};
+        rc = veil_cli_check_outputs(ins, 1, outs, names, 2);
+        if (rc != EXIT_OK) {
+            veil_scene_free(&scene);
+            return rc;
+        }
+    }
+    /* the first frame's files stand for all: folders exist */
     char first_exr[4096], first_png[4096];
     r = veil_frame_pattern_path(a.exr, a.range.first, first_exr, sizeof first_exr, &err);
     if (r == VEIL_OK && a.png) r = veil_frame_pattern_path(a.png, a.range.first, first_png, sizeof first_png, &err);

@@ -45,6 +45,21 @@ cmp -s "$scene" "$work/scene.orig" || { echo "FAIL: the scene was changed throug
 # both outputs one file
 check "render -o X --png X" 2 "-o and --png: both are '$work/x.exr'" \
     "$veil" render "$scene" -o "$work/x.exr" --png "$work/x.exr" "${small[@]}"
+# every frame of a run, not only the first (issue 22, items 1 and 2): a later frame's name that is
+# the scene, and a frame whose EXR and PNG are one file, are usage errors before any frame is written
+mkdir "$work/frames"
+cp "$scene" "$work/frames/s2.json"
+cp "$scene" "$work/frames/s_0001.json"
+check "turntable -o 's#.json', frame 2 is the scene" 2 "-o: '$work/frames/s2.json' is an input of this run" \
+    "$veil" turntable "$work/frames/s2.json" -o "$work/frames/s#.json" --range 1-2 "${small[@]}"
+cmp -s "$work/frames/s2.json" "$scene" || { echo "FAIL: s2.json was changed"; fails=$((fails + 1)); }
+check "render --turntable 2 -o s.json, frame 1 is the scene" 2 "is an input of this run" \
+    "$veil" render "$work/frames/s_0001.json" -o "$work/frames/s.json" --turntable 2 "${small[@]}"
+cmp -s "$work/frames/s_0001.json" "$scene" || { echo "FAIL: s_0001.json was changed"; fails=$((fails + 1)); }
+check "turntable -o 'f#.exr' --png 'f##.exr', frame 10's two files are one" 2 \
+    "-o and --png: both are '$work/frames/f10.exr'" \
+    "$veil" turntable "$work/frames/s2.json" -o "$work/frames/f#.exr" --png "$work/frames/f##.exr" --range 9-10 "${small[@]}"
+[ ! -e "$work/frames/f9.exr" ] || { echo "FAIL: frame 9 was written before the clash was found"; fails=$((fails + 1)); }
 # empty and directory paths: usage errors before any work
 check "render -o ''" 2 "-o: an empty path" "$veil" render "$scene" -o "" "${small[@]}"
 mkdir "$work/dir"
