@@ -87,6 +87,9 @@ static int parse_args(int argc, char** argv, compare_args* a)
             } else if (!parse_positive(v, &a->floor)) {
                 return veil_cli_usage_error(
                     "--floor: expected a positive finite number (absolute, in the images' units), got '%s'", v);
+            } else if (a->floor < VEIL_COMPARE_TINY_FLOOR) { /* it would be raised to it without a word */
+                return veil_cli_usage_error("--floor: expected a number >= 1e-12 (the smallest floor that keeps "
+                                            "every ratio finite), got '%s'", v);
             }
         } else if (s[0] == '-' && s[1]) {
             return veil_cli_usage_error("unknown option '%s'", s);
@@ -175,7 +178,8 @@ static void print_text(const compare_args* a, const veil_compare_stats* st, cons
     else printf("psnr_db        inf (identical RGB)\n");
     printf("alpha_max_abs  %.6g\n", st->alpha_max_abs);
     if (a->bin > 1) printf("bin            %d (means of %dx%d pixel blocks)\n", a->bin, a->bin, a->bin);
-    printf("mean_bias      %+.6g (mean RGB / reference's - 1)\n", x->bias);
+    if (isfinite(x->bias)) printf("mean_bias      %+.6g (mean RGB / reference's - 1)\n", x->bias);
+    else printf("mean_bias      undefined (the reference's mean RGB is 0, the image's is not)\n");
     if (isfinite(x->noise))
         printf("noise          %.6g (reference's standard error, relative%s)\nrel_rmse_excess %.6g (noise taken out)\n",
                x->noise, x->bounded ? "; pixels whose error is a bound add none" : "", x->excess);

@@ -173,7 +173,7 @@ double veil_compare_bias(const float* a, const float* b, int width, int height)
             sa += a[4 * i + (size_t)c];
             sb += b[4 * i + (size_t)c];
         }
-    if (sb == 0.0) return sa == 0.0 ? 0.0 : FLT_MAX;
+    if (sb == 0.0) return sa == 0.0 ? 0.0 : NAN; /* no ratio to an all-black reference: undefined */
     return sa / sb - 1.0;
 }
 

@@ -71,7 +71,7 @@ veil_result veil_compare_bin(const float* rgba, const float* se, int w, int h, i
                              veil_error* err);
 
 /* Mean energy bias of a against the reference b: mean(a RGB) / mean(b RGB)
- * - 1 (0 when both are black; +inf as a huge number: FLT_MAX, when only b is). */
+ * - 1 (0 when both are black; NaN, undefined, when only b is: callers say so rather than print a number). */
 double veil_compare_bias(const float* a, const float* b, int width, int height);
 
 /* The reference's own noise on the scale of the relative RMSE: the rms

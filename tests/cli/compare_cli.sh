@@ -70,6 +70,17 @@ json_check "close(j['rel_rmse'], 0.1) and j['off_5pct'] == 1 and close(j['max_ab
             and close(j['rmse'], 0.1 * math.sqrt(mean_sq)) \
             and close(j['psnr_db'], 10 * math.log10(peak**2 / (0.01 * mean_sq)), 1e-5) \
             and j['alpha_max_abs'] == 0" "scaled --json"
+# an all-black reference (issue 22, item 11): the mean bias is undefined and said so (JSON null),
+# never 3.4e38; a floor below 1e-12 is refused by name instead of raised without a word
+run "$d/scaled.exr" "$d/black.exr" --json
+[ $rc -eq 0 ] || fail "black reference: exit $rc: $(cat "$tmp/err")"
+json_check "j['mean_bias'] is None" "black reference --json"
+run "$d/scaled.exr" "$d/black.exr"
+grep -q '^mean_bias .*undefined' "$tmp/out" || fail "black reference: $(cat "$tmp/out")"
+run "$d/black.exr" "$d/black.exr" --json
+json_check "j['mean_bias'] == 0" "black against black: no bias"
+run "$d/scaled.exr" "$d/ref.exr" --floor 1e-45
+[ $rc -eq 2 ] && grep -q -- "--floor: expected a number >= 1e-12" "$tmp/err" || fail "--floor 1e-45: exit $rc: $(cat "$tmp/err")"
 # a floor of 2 is above every value: the relative error is 0.1 b / 2
 run "$d/scaled.exr" "$d/ref.exr" --floor 2 --json
 [ $rc -eq 0 ] || fail "--floor 2: exit $rc: $(cat "$tmp/err")"
@@ -212,6 +223,6 @@ usage floor_missing "--floor needs a value" "$d/same.exr" "$d/ref.exr" --floor
 usage heatmap_missing "--heatmap needs a value" "$d/same.exr" "$d/ref.exr" --heatmap
 
 left=$(ls "$d" | sort | tr '\n' ' ')
-[ "$left" = "alpha.exr garbage.exr nan.exr one_off.exr ref.exr ref_bound.exr ref_se.exr same.exr scaled.exr small.exr truncated.exr " ] \
+[ "$left" = "alpha.exr black.exr garbage.exr nan.exr one_off.exr ref.exr ref_bound.exr ref_se.exr same.exr scaled.exr small.exr truncated.exr " ] \
   || fail "files left behind: $(ls "$d")"
 echo PASS

@@ -6,6 +6,7 @@
  *   alpha.exr    ref with A of pixel (0, 0) 0.75
  *   nan.exr      ref with B of pixel (5, 4) NaN
  *   small.exr    4x3 (a size mismatch)
+ *   black.exr    8x6, RGB 0, A 1 (an all-black reference: its mean bias is undefined)
  *   ref_se.exr   ref with stderr.R, .G, .B = 0.02 x the value (as `veil reference` writes)
  *   ref_bound.exr ref_se with stderr.bound = 1 everywhere (every error a bound)
  * The script knows these numbers; they are stated here once. */
@@ -68,6 +69,9 @@ int main(int argc, char** argv)
     ok = ok && write(dir, "nan.exr", W, H, img);
 
     ok = ok && write(dir, "small.exr", 4, 3, ref);
+
+    for (int i = 0; i < W * H * 4; ++i) img[i] = (i % 4 == 3) ? 1.0f : 0.0f;
+    ok = ok && write(dir, "black.exr", W, H, img);
 
     /* the reference with standard errors, planes R G B A stderr.R/G/B (stderr.bound) */
     static float planes[8][W * H];
