@@ -165,17 +165,6 @@ static void say(char* why, size_t n, const char* fmt, ...)
     va_end(ap);
 }
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 2, 3)))
-#endif
-static void why(veil_stage_report* rep, const char* fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(rep->why, sizeof rep->why, fmt, ap);
-    va_end(ap);
-}
-
 /* The medium as the passes after propagation read it, with the textures the stages hold (the
  * optical-depth textures are the caller's to add: their array must outlive the use). */
 static veil_lit_medium lit_medium(const veil_frame* f)
@@ -265,7 +254,7 @@ static veil_result inject_build(veil_frame* f, veil_stage_report* rep, veil_erro
         f->st->vdb_voxels = er.vdb_voxels;
         if (!v.has_volume) {
             rep->status = VEIL_STAGE_SKIPPED;
-            why(rep, "the sources hold no density (no particle, no active voxel)");
+            say(rep->why, sizeof rep->why, "the sources hold no density (no particle, no active voxel)");
         } else {
             const veil_grid* g = &v.grid;
             const veil_ev_sparse* sp = veil_ev_sparse_of(r->ev);
@@ -277,7 +266,7 @@ static veil_result inject_build(veil_frame* f, veil_stage_report* rep, veil_erro
                          (double)er.bytes / 1048576.0, (double)g->dims[0] * g->dims[1] * g->dims[2] * 4 / 1048576.0);
             else
                 snprintf(mem, sizeof mem, "; %.1f MiB on the GPU", (double)er.bytes / 1048576.0);
-            why(rep, "%s: %zu particles, %zu VDB voxels, grid %dx%dx%d, voxel %.4g m (%s%s)",
+            say(rep->why, sizeof rep->why, "%s: %zu particles, %zu VDB voxels, grid %dx%dx%d, voxel %.4g m (%s%s)",
                 had ? "the sources changed" : "no volume kept", er.particles, er.vdb_voxels, g->dims[0], g->dims[1],
                 g->dims[2], g->voxel, v.resolution, mem);
         }
@@ -402,11 +391,11 @@ static veil_result propagate_build(veil_frame* f, veil_stage_report* rep, veil_e
         snprintf(suns, sizeof suns, "; %d sun%s in light-space grids (%d computed), %.3g voxels apart across",
                  orep.suns, orep.suns > 1 ? "s" : "", orep.suns_computed, orep.sun_across);
     if (rep->status == VEIL_STAGE_RAN)
-        why(rep, "%d of %zu lights%s, %s, %d passes; %d textures computed (volume or light moved), %d cached%s; "
+        say(rep->why, sizeof rep->why, "%d of %zu lights%s, %s, %d passes; %d textures computed (volume or light moved), %d cached%s; "
             "%.1f MiB", p->light_count - p->emission_lights, p->scene->light_count, from, propagate_method(p),
             orep.iterations, orep.computed, orep.cached, suns, orep.mib);
     else
-        why(rep, "%d lights, %s: the volume, method and lights' geometry are unchanged", p->light_count,
+        say(rep->why, sizeof rep->why, "%d lights, %s: the volume, method and lights' geometry are unchanged", p->light_count,
             propagate_method(p));
     return VEIL_OK;
 }
@@ -485,7 +474,7 @@ static veil_result volumetric_build(veil_frame* f, veil_stage_report* rep, veil_
     f->parts->has[VEIL_STAGE_VOLUMETRIC] = 1, f->parts->kept[VEIL_STAGE_VOLUMETRIC] = rep->key;
     if (vr.skipped) { /* decide() found a grid; the module did not: say so rather than hide it */
         rep->status = VEIL_STAGE_SKIPPED;
-        why(rep, "no grid was made for the field");
+        say(rep->why, sizeof rep->why, "no grid was made for the field");
     }
     return VEIL_OK;
 }
@@ -581,7 +570,7 @@ static veil_result spread_build(veil_frame* f, veil_stage_report* rep, veil_erro
     float thick = veil_spread_max_scattering(s, im->aov_t, q, im->width, im->height);
     if (!(thick >= m->thin_threshold)) {
         rep->status = VEIL_STAGE_SKIPPED;
-        why(rep, "optically thin view: max P sigma_s = %.3g < thin_threshold %g", thick, m->thin_threshold);
+        say(rep->why, sizeof rep->why, "optically thin view: max P sigma_s = %.3g < thin_threshold %g", thick, m->thin_threshold);
         return VEIL_OK;
     }
     size_t floats = (size_t)im->width * (size_t)im->height * 4;
@@ -594,7 +583,7 @@ static veil_result spread_build(veil_frame* f, veil_stage_report* rep, veil_erro
     if (res != VEIL_OK) return res;
     for (size_t i = 0; i < floats; i += 4)
         for (int c = 0; c < 3; ++c) im->rgba[i + (size_t)c] += im->aov_m[i + (size_t)c];
-    why(rep, "max P sigma_s = %.3g >= %g: spreads %s%s%s; %d levels on %dx%d, %s filter: depends on the camera",
+    say(rep->why, sizeof rep->why, "max P sigma_s = %.3g >= %g: spreads %s%s%s; %d levels on %dx%d, %s filter: depends on the camera",
         thick, m->thin_threshold, o->behind ? "the frame behind" : "", o->behind && q ? " and " : "",
         q ? "single scattering's out-scattered light" : "", sr.levels, sr.padded_width, sr.padded_height,
         m->filter == VEIL_SPREAD_2X2 ? "2x2" : m->filter == VEIL_SPREAD_6X6 ? "6x6" : "4x4");
