@@ -102,7 +102,9 @@ veil_result veil_context_create(const veil_context_desc* desc, veil_context** ou
 void veil_context_destroy(veil_context* ctx)
 {
     if (!ctx) return;
-    veil_renderer_destroy(ctx->renderer); /* its GL objects go while the context is current */
+    /* its GL objects go while its context is current (another veil_context may have been since); a context
+     * current on another thread cannot be made current here: its objects go with it, unfreed (misuse) */
+    if (!ctx->gl || veil_gl_make_current(ctx->gl, NULL) == VEIL_OK) veil_renderer_destroy(ctx->renderer);
     veil_gl_destroy(ctx->gl);
     free(ctx);
 }
@@ -161,6 +163,8 @@ veil_result veil_render(veil_context* ctx, const veil_scene* scene, const veil_r
     veil_render_desc d;
     veil_result r = veil__desc_read(&render_desc_layouts, desc, &d, err);
     if (r == VEIL_OK) r = check_render_desc(&d, err);
+    /* one thread may hold several contexts: each call makes its own current (issue 22) */
+    if (r == VEIL_OK) r = veil_gl_make_current(ctx->gl, err);
     if (r != VEIL_OK) return r;
 
     veil_image* img = calloc(1, sizeof *img);

@@ -3,6 +3,7 @@
 
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,6 +18,49 @@
 #ifndef EGL_DRM_RENDER_NODE_FILE_EXT
 #define EGL_DRM_RENDER_NODE_FILE_EXT 0x3377
 #endif
+
+/* EGL hands every context of one device the same EGLDisplay, and
+ * eglTerminate on it ends them all: a second veil_gl made and destroyed on
+ * the same device left the first one rendering NaN (issue 22). Displays are
+ * therefore counted, and terminated when their last veil_gl goes. */
+#define VEIL__MAX_DISPLAYS 16
+static struct {
+    EGLDisplay display;
+    int users;
+} g_displays[VEIL__MAX_DISPLAYS];
+static pthread_mutex_t g_displays_lock = PTHREAD_MUTEX_INITIALIZER;
+
+/* eglInitialize, counted; 0 when it fails or too many displays are live. */
+static int display_acquire(EGLDisplay d)
+{
+    pthread_mutex_lock(&g_displays_lock);
+    int slot = -1, ok = 0;
+    for (int i = 0; i < VEIL__MAX_DISPLAYS && slot < 0; ++i)
+        if (g_displays[i].users > 0 && g_displays[i].display == d) slot = i;
+    for (int i = 0; i < VEIL__MAX_DISPLAYS && slot < 0; ++i)
+        if (g_displays[i].users == 0) slot = i;
+    EGLint major, minor;
+    if (slot >= 0 && (g_displays[slot].users > 0 || eglInitialize(d, &major, &minor))) {
+        g_displays[slot].display = d;
+        g_displays[slot].users++;
+        ok = 1;
+    }
+    pthread_mutex_unlock(&g_displays_lock);
+    return ok;
+}
+
+/* The counterpart of display_acquire: eglTerminate once no veil_gl uses d. */
+static void display_release(EGLDisplay d)
+{
+    pthread_mutex_lock(&g_displays_lock);
+    for (int i = 0; i < VEIL__MAX_DISPLAYS; ++i) {
+        if (g_displays[i].users > 0 && g_displays[i].display == d) {
+            if (--g_displays[i].users == 0) eglTerminate(d);
+            break;
+        }
+    }
+    pthread_mutex_unlock(&g_displays_lock);
+}
 
 /* Most devices a machine could expose that we look at. */
 #define VEIL__MAX_EGL_DEVICES 16
@@ -122,8 +166,7 @@ static veil_result try_device_platform(veil_gl* gl, const veil_gl_desc* desc, in
                 last = egl_fail(err, "eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT)", NULL);
                 continue;
             }
-            EGLint major, minor;
-            if (!eglInitialize(gl->display, &major, &minor)) {
+            if (!display_acquire(gl->display)) {
                 last = egl_fail(err, "eglInitialize(device display)", NULL);
                 gl->display = EGL_NO_DISPLAY;
                 continue;
@@ -135,7 +178,7 @@ static veil_result try_device_platform(veil_gl* gl, const veil_gl_desc* desc, in
                 describe_device(gl, devs[i]);
                 return VEIL_OK;
             }
-            eglTerminate(gl->display);
+            display_release(gl->display);
             gl->display = EGL_NO_DISPLAY;
         }
     }
@@ -147,14 +190,13 @@ static veil_result try_surfaceless(veil_gl* gl, const veil_gl_desc* desc, veil_e
     gl->display = eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
     if (gl->display == EGL_NO_DISPLAY)
         return egl_fail(err, "eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA)", NULL);
-    EGLint major, minor;
-    if (!eglInitialize(gl->display, &major, &minor)) {
+    if (!display_acquire(gl->display)) {
         gl->display = EGL_NO_DISPLAY;
         return egl_fail(err, "eglInitialize(surfaceless display)", NULL);
     }
     veil_result r = make_context(gl, desc, err);
     if (r != VEIL_OK) {
-        eglTerminate(gl->display);
+        display_release(gl->display);
         gl->display = EGL_NO_DISPLAY;
         return r;
     }
@@ -264,11 +306,22 @@ void veil_gl_destroy(veil_gl* gl)
 {
     if (!gl) return;
     if (gl->display != EGL_NO_DISPLAY) {
-        eglMakeCurrent(gl->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        /* release the thread's context only when it is this one: another veil_gl may be current */
+        if (eglGetCurrentContext() == gl->context)
+            eglMakeCurrent(gl->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         if (gl->context != EGL_NO_CONTEXT) eglDestroyContext(gl->display, gl->context);
-        eglTerminate(gl->display);
+        display_release(gl->display);
     }
     free(gl);
+}
+
+veil_result veil_gl_make_current(const veil_gl* gl, veil_error* err)
+{
+    if (eglGetCurrentContext() == gl->context) return VEIL_OK;
+    if (!eglMakeCurrent(gl->display, EGL_NO_SURFACE, EGL_NO_SURFACE, gl->context))
+        return egl_fail(err, "eglMakeCurrent(no surface)",
+                        "the veil_context could not be made current on this thread (is it current on another?)");
+    return VEIL_OK;
 }
 
 const veil_gl_info* veil_gl_get_info(const veil_gl* gl) { return &gl->info; }

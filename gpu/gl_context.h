@@ -37,6 +37,10 @@ typedef struct veil_gl_info {
 
 veil_result veil_gl_create(const veil_gl_desc* desc, veil_gl** out, veil_error* err);
 void veil_gl_destroy(veil_gl* gl); /* accepts NULL */
+/* Makes gl's context current on the calling thread (a no-op when it is):
+ * several veil_gl may live on one thread, each made current before use.
+ * VEIL_ERR_GPU when it is current on another thread. */
+veil_result veil_gl_make_current(const veil_gl* gl, veil_error* err);
 const veil_gl_info* veil_gl_get_info(const veil_gl* gl);
 
 #endif

@@ -22,10 +22,12 @@
  * err is not NULL, writes a sentence saying what went wrong into it. veil
  * never prints and never exits.
  *
- * Threading: a veil_context makes an OpenGL context current on the thread
- * that creates it; use it (and the images it renders) on that thread only,
- * one context per thread. Scenes and images hold no GL objects: once made
- * they can be read from any thread.
+ * Threading: a veil_context holds an OpenGL context, which veil_render and
+ * veil_context_destroy make current on the calling thread, where it stays:
+ * one thread may hold and use several contexts, but use each context from
+ * the thread that created it (elsewhere veil_render returns VEIL_ERR_GPU).
+ * Scenes and images hold no GL objects: once made they can be read from any
+ * thread.
  *
  * ABI: libveil.so exports exactly the functions declared here and in
  * veil/result.h, each marked VEIL_API; everything else is hidden. The

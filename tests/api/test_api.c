@@ -182,6 +182,37 @@ static void render_and_read(veil_context* ctx, const veil_scene* scene)
     veil_image_destroy(img);
 }
 
+/* Several contexts on one thread (issue 22): a second context made, used
+ * and destroyed leaves the first one's renders bit for bit as they were.
+ * Before each call made its own context current, the first context rendered
+ * through the second's (VEIL_OK, wrong pixels), and after the second was
+ * destroyed (eglTerminate of the display both share) NaN. */
+static void two_contexts(veil_context* ctx, const veil_scene* scene)
+{
+    veil_error err = {{0}};
+    veil_render_desc desc = {.width = 24, .height = 18, .seed = 3};
+    veil_image *before = NULL, *during = NULL, *second = NULL, *after = NULL;
+    CHECK(veil_render(ctx, scene, &desc, &before, &err) == VEIL_OK, "first context: %s", err.msg);
+    veil_context* ctx2 = NULL;
+    CHECK(veil_context_create(NULL, &ctx2, &err) == VEIL_OK && ctx2, "second context: %s", err.msg);
+    if (!before || !ctx2) {
+        veil_image_destroy(before);
+        veil_context_destroy(ctx2);
+        return;
+    }
+    CHECK(veil_render(ctx, scene, &desc, &during, &err) == VEIL_OK, "first context beside a second: %s", err.msg);
+    CHECK(during && same_pixels(during, before), "the first context renders as before while a second lives");
+    CHECK(veil_render(ctx2, scene, &desc, &second, &err) == VEIL_OK, "second context: %s", err.msg);
+    CHECK(second && same_pixels(second, before), "the second context renders what the first does");
+    veil_context_destroy(ctx2);
+    CHECK(veil_render(ctx, scene, &desc, &after, &err) == VEIL_OK, "first context after the second: %s", err.msg);
+    CHECK(after && same_pixels(after, before), "the first context renders as before once the second is gone");
+    veil_image_destroy(before);
+    veil_image_destroy(during);
+    veil_image_destroy(second);
+    veil_image_destroy(after);
+}
+
 int main(int argc, char** argv)
 {
     if (argc != 2) {
@@ -196,6 +227,7 @@ int main(int argc, char** argv)
     if (scene && test_dir_begin("api")) {
         bad_descriptions(ctx, scene);
         render_and_read(ctx, scene);
+        two_contexts(ctx, scene);
         CHECK(test_dir_end(), "temporary folder left clean");
     }
     veil_scene_close(scene);
