@@ -12,6 +12,7 @@
  * Exit 77 (skipped) when no GL context can be made, except under CI=true. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -213,6 +214,35 @@ static void two_contexts(veil_context* ctx, const veil_scene* scene)
     veil_image_destroy(after);
 }
 
+/* A context current on this thread, used from another: refused with
+ * VEIL_ERR_GPU (veil.h, "Threading"), never rendered through. */
+typedef struct other_thread_call {
+    veil_context* ctx;
+    const veil_scene* scene;
+    veil_result r;
+    veil_image* img;
+    veil_error err;
+} other_thread_call;
+
+static void* render_elsewhere(void* arg)
+{
+    other_thread_call* c = arg;
+    veil_render_desc desc = {.width = 8, .height = 6};
+    c->r = veil_render(c->ctx, c->scene, &desc, &c->img, &c->err);
+    return NULL;
+}
+
+static void other_thread(veil_context* ctx, const veil_scene* scene)
+{
+    other_thread_call c = {.ctx = ctx, .scene = scene};
+    pthread_t t;
+    CHECK(pthread_create(&t, NULL, render_elsewhere, &c) == 0, "pthread_create");
+    pthread_join(t, NULL);
+    CHECK(c.r == VEIL_ERR_GPU && c.img == NULL, "a context current on another thread: %s, %s",
+          veil_result_name(c.r), c.err.msg);
+    veil_image_destroy(c.img);
+}
+
 int main(int argc, char** argv)
 {
     if (argc != 2) {
@@ -228,6 +258,7 @@ int main(int argc, char** argv)
         bad_descriptions(ctx, scene);
         render_and_read(ctx, scene);
         two_contexts(ctx, scene);
+        other_thread(ctx, scene);
         CHECK(test_dir_end(), "temporary folder left clean");
     }
     veil_scene_close(scene);
