@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "core/text.h"
 #include "io/tempfile.h"
 
 int veil_cli_usage_error(const char* fmt, const char* arg)
@@ -24,7 +25,10 @@ int veil_cli_exit_code(veil_result r)
 
 int veil_cli_fail(veil_result r, const veil_error* err)
 {
-    fprintf(stderr, "veil: %s\n", err->msg[0] ? err->msg : veil_result_message(r));
+    /* a message may quote a file's bytes (a grid's name): control characters are escaped, lines kept */
+    char shown[4 * VEIL_ERROR_MAX];
+    veil_text_printable(err->msg[0] ? err->msg : veil_result_message(r), shown, sizeof shown, 1);
+    fprintf(stderr, "veil: %s\n", shown);
     return veil_cli_exit_code(r);
 }
 

@@ -5,13 +5,34 @@
 #include <string.h>
 
 #include "cli_util.h"
+#include "core/text.h"
 #include "commands.h"
 #include "io/vdb.h"
 #include "volume/scene_volume.h"
 
+/* A file's string for the terminal: control characters and bytes that are not UTF-8 as \xNN (core/text.h). */
+typedef struct shown {
+    char s[4 * 256 + 1];
+} shown;
+
+static shown show(const char* text)
+{
+    shown t;
+    veil_text_printable(text, t.s, sizeof t.s, 0);
+    return t;
+}
+
+/* The columns a printable UTF-8 string takes: its characters (bytes that do not continue one). */
+static int columns(const char* s)
+{
+    int n = 0;
+    for (; *s; ++s) n += ((unsigned char)*s & 0xC0) != 0x80;
+    return n;
+}
+
 static void print_info_grid(const veil_vdb_grid_info* g)
 {
-    printf("\ngrid '%s'\n", g->name);
+    printf("\ngrid '%s'\n", show(g->name).s);
     if (g->active_voxels == 0) {
         printf("  index bbox   (empty)\n");
     } else {
@@ -22,7 +43,7 @@ static void print_info_grid(const veil_vdb_grid_info* g)
             printf("  world bbox   [%g, %g, %g] .. [%g, %g, %g] m\n", g->world_lo[0], g->world_lo[1], g->world_lo[2],
                    g->world_hi[0], g->world_hi[1], g->world_hi[2]);
     }
-    printf("  transform    %s%s\n", g->map_type, g->affine ? " (index to world, column vectors)" : " (not affine)");
+    printf("  transform    %s%s\n", show(g->map_type).s, g->affine ? " (index to world, column vectors)" : " (not affine)");
     for (int r = 0; g->affine && r < 4; ++r)
         printf("               [%10.6g %10.6g %10.6g %10.6g]\n", g->index_to_world[r][0], g->index_to_world[r][1],
                g->index_to_world[r][2], g->index_to_world[r][3]);
@@ -73,8 +94,8 @@ int veil_cmd_info(int argc, char** argv)
     veil_result r = veil_vdb_file_info(path, &grids, &n, &err);
     if (r != VEIL_OK) return veil_cli_fail(r, &err);
     int w = 4; /* name column: the longest name */
-    for (size_t i = 0; i < n; ++i) w = (int)strlen(grids[i].name) > w ? (int)strlen(grids[i].name) : w;
-    printf("%s: %zu grid%s\n\n", path, n, n == 1 ? "" : "s");
+    for (size_t i = 0; i < n; ++i) w = columns(show(grids[i].name).s) > w ? columns(show(grids[i].name).s) : w;
+    printf("%s: %zu grid%s\n\n", show(path).s, n, n == 1 ? "" : "s");
     printf("  %-*s  %-10s  %-8s  %13s  %s\n", w, "name", "class", "type", "active voxels", "voxel size (m)");
     for (size_t i = 0; i < n; ++i) {
         const veil_vdb_grid_info* g = &grids[i];
@@ -84,8 +105,9 @@ int veil_cmd_info(int argc, char** argv)
             snprintf(vs, sizeof vs, "%g", g->voxel_size[0]);
         else
             snprintf(vs, sizeof vs, "%g x %g x %g", g->voxel_size[0], g->voxel_size[1], g->voxel_size[2]);
-        printf("  %-*s  %-10s  %-8s  %13llu  %s\n", w, g->name, g->grid_class, g->value_type,
-               (unsigned long long)g->active_voxels, vs);
+        const shown name = show(g->name);
+        printf("  %s%*s  %-10s  %-8s  %13llu  %s\n", name.s, w - columns(name.s), "", show(g->grid_class).s,
+               show(g->value_type).s, (unsigned long long)g->active_voxels, vs);
     }
     for (size_t i = 0; i < n; ++i) print_info_grid(&grids[i]);
     veil_vdb_file_info_free(grids, n);

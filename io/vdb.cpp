@@ -18,6 +18,7 @@
 #pragma GCC visibility push(hidden)
 #include "vdb.h"
 #include "vdb_header.hpp"
+#include "../core/text.h"
 #pragma GCC visibility pop
 
 #include <openvdb/openvdb.h>
@@ -426,19 +427,28 @@ cJSON* json_pair(cJSON* a, cJSON* b)
     return p;
 }
 
+// A string of the file as JSON can hold it: its bytes that are not UTF-8
+// become U+FFFD (core/text.h); cJSON escapes the control characters.
+cJSON* add_text(cJSON* o, const char* key, const char* text)
+{
+    std::string out(3 * strlen(text) + 1, '\0');
+    veil_text_utf8(text, &out[0], out.size());
+    return cJSON_AddStringToObject(o, key, out.c_str());
+}
+
 cJSON* grid_json(const veil_vdb_grid_info& g)
 {
     cJSON* o = cJSON_CreateObject();
-    cJSON_AddStringToObject(o, "name", g.name);
-    cJSON_AddStringToObject(o, "class", g.grid_class);
-    cJSON_AddStringToObject(o, "value_type", g.value_type);
+    add_text(o, "name", g.name);
+    add_text(o, "class", g.grid_class);
+    add_text(o, "value_type", g.value_type);
     cJSON_AddNumberToObject(o, "active_voxels", (double)g.active_voxels);
     const bool empty = g.active_voxels == 0;
     cJSON_AddItemToObject(o, "index_bbox", empty ? cJSON_CreateNull() : json_pair(json_ints(g.index_lo), json_ints(g.index_hi)));
     cJSON_AddItemToObject(o, "world_bbox", empty || !g.affine ? cJSON_CreateNull()
                                                               : json_pair(json_doubles(g.world_lo), json_doubles(g.world_hi)));
     cJSON_AddItemToObject(o, "voxel_size", json_doubles(g.voxel_size));
-    cJSON_AddStringToObject(o, "map_type", g.map_type);
+    add_text(o, "map_type", g.map_type);
     if (g.affine) {
         cJSON* m = cJSON_CreateArray();
         for (int r = 0; r < 4; ++r) cJSON_AddItemToArray(m, cJSON_CreateDoubleArray(g.index_to_world[r], 4));
@@ -623,7 +633,7 @@ veil_result veil_vdb_info_json(const char* path, char** json_out, veil_error* er
     cJSON* root = cJSON_CreateObject();
     cJSON* arr = cJSON_CreateArray();
     if (root && arr) {
-        cJSON_AddStringToObject(root, "file", path);
+        add_text(root, "file", path);
         cJSON_AddItemToObject(root, "grids", arr);
         arr = nullptr;
         for (size_t i = 0; i < n; ++i) cJSON_AddItemToArray(cJSON_GetObjectItem(root, "grids"), grid_json(grids[i]));

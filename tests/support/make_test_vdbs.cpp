@@ -580,8 +580,26 @@ int main(int argc, char** argv)
         std::printf("wrote %s and %s\n", argv[2], argv[3]);
         return 0;
     }
+    if (argc == 3 && std::strcmp(argv[1], "--odd-names") == 0) {
+        // grid names a file may hold but a terminal or JSON cannot take as they are (issue 22): an escape
+        // sequence, bytes that are not UTF-8 (0xFF, a lone continuation, an overlong '/'), and valid UTF-8
+        try {
+            openvdb::initialize();
+            FloatGrid::Ptr a = float_grid("den\x1b[31msity\xff", 0.1), b = float_grid("caf\xc3\xa9 \x80\xc0\xaf", 0.1);
+            a->tree().setValue(openvdb::Coord(0, 0, 0), 1.0f);
+            b->tree().setValue(openvdb::Coord(1, 2, 3), 0.5f);
+            openvdb::io::File file(argv[2]);
+            file.write({a, b});
+            file.close();
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "make_test_vdbs: %s\n", e.what());
+            return 1;
+        }
+        std::printf("wrote %s\n", argv[2]);
+        return 0;
+    }
     if (argc < 2 || argc > 3 || (argc == 3 && std::strcmp(argv[2], "--big") != 0)) {
-        std::fprintf(stderr, "usage: %s DIR [--big] | --plume FILE | --plume-faded FILE | --pyro FILE | --pair A B\n", argv[0]);
+        std::fprintf(stderr, "usage: %s DIR [--big] | --plume FILE | --plume-faded FILE | --pyro FILE | --pair A B | --odd-names FILE\n", argv[0]);
         return 2;
     }
     g_dir = argv[1];
