@@ -16,8 +16,9 @@
  * Z / cos(angle off the axis). --depth-is distance reads it as the
  * distance along the ray. +inf (sky, nothing hit) is allowed.
  * Errors (exit 1, nothing written): FRAME missing or not an EXR, no depth
- * channel, a size other than the scene camera's, a NaN or negative depth,
- * a non-finite colour.
+ * channel (or one that is neither half nor float), a size other than the
+ * scene camera's, a NaN or negative depth, a non-finite colour or one over
+ * 1e38. Negative colour values are read as 0, with a note.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -71,6 +72,13 @@ static int parse_fog_args(int argc, char** argv, fog_args* a)
     return -1;
 }
 
+/* The frame's radiance the fog may attenuate: the output is T L + the fog's
+ * own radiance, T <= 1 and the fog's < 2.6e37 (scene/limits.h), so L <=
+ * 1e38 keeps every output value under FLT_MAX = 3.4e38. Negative values
+ * (no light is negative; a sharpening filter's ringing makes them) are
+ * read as 0, with a note: fog over them would stay negative. */
+#define FOG_MAX_RADIANCE 1e38
+
 /* The frame's depth plane: the named channel, or the first usual one. */
 static veil_result read_depth(const fog_args* a, int w, int h, float** depth, const char** used, veil_error* err)
 {
@@ -80,7 +88,13 @@ static veil_result read_depth(const fog_args* a, int w, int h, float** depth, co
     for (int i = 0; names[i]; ++i) {
         int dw = 0, dh = 0;
         veil_error e = {0};
-        if (veil_read_exr_channel(a->frame, names[i], &dw, &dh, depth, &e) != VEIL_OK) continue;
+        veil_result r = veil_read_exr_channel(a->frame, names[i], &dw, &dh, depth, &e);
+        if (r == VEIL_ERR_INVALID) continue; /* no such channel: the next name */
+        if (r != VEIL_OK) {
+            /* there, but unreadable (a uint channel, say): that, not "no depth channel" */
+            veil_fail(err, r, "%s (the depth channel)", e.msg);
+            return r;
+        }
         if (dw != w || dh != h) {
             free(*depth);
             *depth = NULL;
@@ -143,13 +157,23 @@ int veil_cmd_fog(int argc, char** argv)
         r = veil_fail(&err, VEIL_ERR_INVALID, "%s is %dx%d but the scene %s's camera is %dx%d (camera.width, "
                       "camera.height): the frame must be rendered with the scene's camera", a.frame, w, h, a.scene,
                       scene.camera.width, scene.camera.height);
-    for (size_t i = 0; r == VEIL_OK && i < (size_t)w * (size_t)h * 4; ++i)
-        if (i % 4 != 3 && !isfinite(frame[i])) {
+    size_t negative = 0, first_negative = 0;
+    for (size_t i = 0; r == VEIL_OK && i < (size_t)w * (size_t)h * 4; ++i) {
+        if (i % 4 == 3) continue;
+        if (!isfinite(frame[i]) || frame[i] > FOG_MAX_RADIANCE) {
             char got[32];
-            r = veil_fail(&err, VEIL_ERR_INVALID, "%s: pixel (%zu, %zu) channel %c is %s: expected finite radiance",
-                          a.frame, (i / 4) % (size_t)w, (i / 4) / (size_t)w, "RGB"[i % 4],
-                          veil_number_text(frame[i], got, sizeof got));
+            r = veil_fail(&err, VEIL_ERR_INVALID, "%s: pixel (%zu, %zu) channel %c is %s: expected finite radiance "
+                          "<= %g", a.frame, (i / 4) % (size_t)w, (i / 4) / (size_t)w, "RGB"[i % 4],
+                          veil_number_text(frame[i], got, sizeof got), FOG_MAX_RADIANCE);
+        } else if (frame[i] < 0.0f) {
+            if (negative++ == 0) first_negative = i;
+            frame[i] = 0.0f;
         }
+    }
+    if (r == VEIL_OK && negative)
+        fprintf(stderr, "veil: note: %s: %zu value%s of negative radiance (a filter's ringing?), the first at pixel "
+                "(%zu, %zu) channel %c, read as 0\n", a.frame, negative, negative == 1 ? "" : "s",
+                (first_negative / 4) % (size_t)w, (first_negative / 4) / (size_t)w, "RGB"[first_negative % 4]);
     if (r == VEIL_OK) r = read_depth(&a, w, h, &depth, &channel, &err);
     if (r == VEIL_OK) r = to_distance(&a, &scene.camera, w, h, channel, depth, &err);
     veil_gl* gl = NULL;

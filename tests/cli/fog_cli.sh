@@ -32,6 +32,12 @@ check 0 "channel depth.Z" "$dir/depthz.exr" --scene "$dir/fog_scene.json" -o "$d
 check 0 "as distance along the ray" "$dir/sky.exr" --scene "$dir/fog_scene.json" -o "$dir/out3.exr" --depth-is distance
 echo keep > "$dir/keep.exr"
 check 1 "no depth channel" "$dir/noz.exr" --scene "$dir/fog_scene.json" -o "$dir/keep.exr"
+# issue 22: a depth channel of uint is named as such, not "no depth channel"
+check 1 "channel Z has pixel type uint" "$dir/uintz.exr" --scene "$dir/fog_scene.json" -o "$dir/keep.exr"
+check 1 "pixel (1, 1) channel R is 3e+38: expected finite radiance <= 1e+38" "$dir/hugergb.exr" --scene "$dir/fog_scene.json" -o "$dir/keep.exr"
+# negative radiance behind the fog is read as 0 (a note says so): no negative value comes out
+check 0 "1 value of negative radiance" "$dir/negrgb.exr" --scene "$dir/fog_scene.json" -o "$dir/neg.exr"
+"$STATS" --rgba "$dir/neg.exr" > "$dir/negstats.txt" || { echo "FAIL: negative radiance through the fog: $(cat "$dir/negstats.txt")"; fail=1; }
 check 1 "pixel (7, 3) is not a number" "$dir/nanz.exr" --scene "$dir/fog_scene.json" -o "$dir/keep.exr"
 check 1 "pixel (0, 0) is -1" "$dir/negz.exr" --scene "$dir/fog_scene.json" -o "$dir/keep.exr"
 check 1 "camera.width" "$dir/small.exr" --scene "$dir/fog_scene.json" -o "$dir/keep.exr"
