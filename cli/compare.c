@@ -40,6 +40,7 @@
 #include "io/image.h"
 #include "reference/compare.h"
 #include "cli_util.h"
+#include "core/text.h"
 #include "commands.h"
 
 typedef struct compare_args {
@@ -110,8 +111,10 @@ static int parse_args(int argc, char** argv, compare_args* a)
  * bytes (UTF-8 file names) as they are. */
 static void print_json_string(const char* s)
 {
+    char text[3 * 4096 + 1]; /* bytes that are not UTF-8 become U+FFFD (core/text.h): JSON holds text only */
+    veil_text_utf8(s, text, sizeof text);
     putchar('"');
-    for (const unsigned char* p = (const unsigned char*)s; *p; ++p) {
+    for (const unsigned char* p = (const unsigned char*)text; *p; ++p) {
         if (*p == '"' || *p == '\\') printf("\\%c", *p);
         else if (*p < 0x20) printf("\\u%04x", *p);
         else putchar(*p);
@@ -204,6 +207,71 @@ static veil_result write_heatmap(const char* path, int w, int h, const float* re
     return r;
 }
 
+/* One channel of the reference's standard errors (or its stderr.bound): absent (*plane NULL, VEIL_OK), or
+ * w x h finite values >= 0 (a standard error; stderr.bound: 0 or 1). Anything else is refused, naming the
+ * file, the channel and the first bad pixel: a NaN or negative error made the noise NaN or smaller than it
+ * is, and the excess error with it. */
+static veil_result read_error_channel(const char* path, const char* name, int w, int h, float** plane, veil_error* err)
+{
+    int cw = 0, ch = 0;
+    veil_error e = {0};
+    veil_result r = veil_read_exr_channel(path, name, &cw, &ch, plane, &e);
+    if (r == VEIL_ERR_INVALID) return VEIL_OK; /* absent */
+    if (r != VEIL_OK) return veil_fail(err, r, "%s", e.msg);
+    if (cw != w || ch != h) {
+        free(*plane), *plane = NULL;
+        return veil_fail(err, VEIL_ERR_INVALID, "%s: channel %s is %dx%d, the image %dx%d", path, name, cw, ch, w, h);
+    }
+    const int is_bound = strcmp(name, "stderr.bound") == 0;
+    size_t bad = 0, first = 0;
+    for (size_t i = 0; i < (size_t)w * (size_t)h; ++i) {
+        const float v = (*plane)[i];
+        if (is_bound ? !(v == 0.0f || v == 1.0f) : !(isfinite(v) && v >= 0.0f))
+            if (bad++ == 0) first = i;
+    }
+    if (!bad) return VEIL_OK;
+    char got[32];
+    veil_fail(err, VEIL_ERR_INVALID, "%s: channel %s at pixel (%zu, %zu) is %s: expected %s (%zu pixel%s so)", path,
+              name, first % (size_t)w, first / (size_t)w, veil_number_text((*plane)[first], got, sizeof got),
+              is_bound ? "0 or 1" : "a finite standard error >= 0", bad, bad == 1 ? "" : "s");
+    free(*plane), *plane = NULL;
+    return VEIL_ERR_INVALID;
+}
+
+/* The reference's standard errors, interleaved RGB in *se (NULL when it has none: all three or none of
+ * stderr.R, .G, .B), with the pixels whose error is a bound (stderr.bound = 1: every sample was the same)
+ * set to 0 and counted in *bounded: a bound is no measure of noise, so the noise is never overstated. */
+static veil_result read_standard_errors(const char* path, int w, int h, float** se, size_t* bounded, veil_error* err)
+{
+    static const char* const names[3] = {"stderr.R", "stderr.G", "stderr.B"};
+    float* planes[3] = {NULL, NULL, NULL};
+    float* bound = NULL;
+    veil_result r = VEIL_OK;
+    int have = 0;
+    for (int c = 0; c < 3 && r == VEIL_OK; ++c) {
+        r = read_error_channel(path, names[c], w, h, &planes[c], err);
+        have += planes[c] != NULL;
+    }
+    if (r == VEIL_OK && have != 0 && have != 3) {
+        char list[64] = "";
+        for (int c = 0; c < 3; ++c)
+            if (planes[c]) snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", list[0] ? ", " : "", names[c]);
+        r = veil_fail(err, VEIL_ERR_INVALID, "%s: has %s but not all of stderr.R, stderr.G, stderr.B", path, list);
+    }
+    if (r == VEIL_OK && have == 3) r = read_error_channel(path, "stderr.bound", w, h, &bound, err);
+    const size_t n = (size_t)w * (size_t)h;
+    if (r == VEIL_OK && have == 3 && !(*se = malloc(n * 3 * sizeof **se)))
+        r = veil_fail(err, VEIL_ERR_OOM, "%s: out of memory for the standard errors", path);
+    for (size_t i = 0; r == VEIL_OK && have == 3 && i < n; ++i) {
+        const int b = bound && bound[i] != 0.0f;
+        for (int c = 0; c < 3; ++c) (*se)[3 * i + (size_t)c] = b ? 0.0f : planes[c][i];
+        *bounded += (size_t)b;
+    }
+    for (int c = 0; c < 3; ++c) free(planes[c]);
+    free(bound);
+    return r;
+}
+
 int veil_cmd_compare(int argc, char** argv)
 {
     compare_args a;
@@ -234,37 +302,7 @@ int veil_cmd_compare(int argc, char** argv)
     float* se = NULL;
     if (r == VEIL_OK) {
         /* the reference's standard errors, when it has them */
-        static const char* const names[3] = {"stderr.R", "stderr.G", "stderr.B"};
-        veil_error ignored = {0};
-        for (int c = 0; c < 3; ++c) {
-            int w = 0, h = 0;
-            float* plane = NULL;
-            if (veil_read_exr_channel(a.reference, names[c], &w, &h, &plane, &ignored) != VEIL_OK || w != wa ||
-                h != ha) {
-                free(plane);
-                free(se);
-                se = NULL;
-                break;
-            }
-            if (!se && !(se = malloc((size_t)wa * (size_t)ha * 3 * sizeof *se))) {
-                free(plane);
-                break;
-            }
-            for (size_t i = 0; i < (size_t)wa * (size_t)ha; ++i) se[3 * i + (size_t)c] = plane[i];
-            free(plane);
-        }
-        /* a standard error that is a bound (stderr.bound = 1: every sample was the same) is no
-         * measure of noise: such pixels add none, so the noise is never overstated */
-        int bw = 0, bh = 0;
-        float* bound = NULL;
-        if (se && veil_read_exr_channel(a.reference, "stderr.bound", &bw, &bh, &bound, &ignored) == VEIL_OK &&
-            bw == wa && bh == ha)
-            for (size_t i = 0; i < (size_t)wa * (size_t)ha; ++i)
-                if (bound[i] != 0.0f) {
-                    se[3 * i] = se[3 * i + 1] = se[3 * i + 2] = 0.0f;
-                    ++x.bounded;
-                }
-        free(bound);
+        r = read_standard_errors(a.reference, wa, ha, &se, &x.bounded, &err);
     }
     if (r == VEIL_OK && a.bin > 1) {
         if (a.heatmap) r = veil_fail(&err, VEIL_ERR_INVALID, "--heatmap is per pixel: leave out --bin");

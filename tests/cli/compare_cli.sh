@@ -99,6 +99,21 @@ json_check "close(j['noise'], 0.02, 1e-5) and close(j['rel_rmse_excess'], math.s
 # every error a bound: no noise is taken out
 run "$d/scaled.exr" "$d/ref_bound.exr" --json
 json_check "j['noise'] == 0 and close(j['rel_rmse_excess'], 0.1, 1e-5)" "stderr.bound"
+# standard errors that are not ones (issue 22): refused, naming the channel and the pixel
+run "$d/scaled.exr" "$d/ref_se_nan.exr" --json
+[ $rc -eq 1 ] && grep -q "channel stderr.G at pixel (3, 2) is not a number" "$tmp/err" \
+  || fail "a NaN standard error: exit $rc: $(cat "$tmp/err")"
+run "$d/scaled.exr" "$d/ref_se_neg.exr"
+[ $rc -eq 1 ] && grep -q "channel stderr.B at pixel (0, 1) is -0.01" "$tmp/err" \
+  || fail "a negative standard error: exit $rc: $(cat "$tmp/err")"
+run "$d/scaled.exr" "$d/ref_se_part.exr"
+[ $rc -eq 1 ] && grep -q "has stderr.R but not all of" "$tmp/err" \
+  || fail "stderr.R alone: exit $rc: $(cat "$tmp/err")"
+# a file name that is not UTF-8 stays JSON (U+FFFD)
+cp "$d/scaled.exr" "$tmp/$(printf 'sc\xffaled.exr')"
+run "$tmp/$(printf 'sc\xffaled.exr')" "$d/ref.exr" --json
+[ $rc -eq 0 ] && /usr/bin/python3 -c 'import json,sys; j=json.loads(open(sys.argv[1],"rb").read().decode("utf-8")); assert j["image"].endswith("sc\ufffdaled.exr")' "$tmp/out" \
+  || fail "a file name that is not UTF-8 in --json: exit $rc: $(cat "$tmp/out" "$tmp/err" | head -c 400)"
 # --bin 2: 4x3 blocks of means; scaled stays 0.1 off, with the same bias; a block mean's
 # standard error is sqrt(sum se^2) / 4 = 0.02 sqrt(sum r^2) / 4, relative to its mean sum r / 4:
 # 0.02 sqrt(sum r^2) / sum r, which is 0.01 for equal r and at most 0.01 (1 + (dr/r)^2 / 8) for
@@ -223,6 +238,6 @@ usage floor_missing "--floor needs a value" "$d/same.exr" "$d/ref.exr" --floor
 usage heatmap_missing "--heatmap needs a value" "$d/same.exr" "$d/ref.exr" --heatmap
 
 left=$(ls "$d" | sort | tr '\n' ' ')
-[ "$left" = "alpha.exr black.exr garbage.exr nan.exr one_off.exr ref.exr ref_bound.exr ref_se.exr same.exr scaled.exr small.exr truncated.exr " ] \
+[ "$left" = "alpha.exr black.exr garbage.exr nan.exr one_off.exr ref.exr ref_bound.exr ref_se.exr ref_se_nan.exr ref_se_neg.exr ref_se_part.exr same.exr scaled.exr small.exr truncated.exr " ] \
   || fail "files left behind: $(ls "$d")"
 echo PASS

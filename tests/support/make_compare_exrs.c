@@ -9,6 +9,8 @@
  *   black.exr    8x6, RGB 0, A 1 (an all-black reference: its mean bias is undefined)
  *   ref_se.exr   ref with stderr.R, .G, .B = 0.02 x the value (as `veil reference` writes)
  *   ref_bound.exr ref_se with stderr.bound = 1 everywhere (every error a bound)
+ *   ref_se_nan.exr, ref_se_neg.exr  ref_se with stderr.G of pixel (3, 2) NaN, stderr.B of (0, 1) -0.01
+ *   ref_se_part.exr ref with stderr.R alone
  * The script knows these numbers; they are stated here once. */
 #include "io/image.h"
 
@@ -91,6 +93,23 @@ int main(int argc, char** argv)
             fprintf(stderr, "make_compare_exrs: %s\n", err.msg);
             ok = 0;
         }
+    }
+    /* bad standard errors: a NaN in stderr.G at (3, 2), a negative stderr.B at (0, 1), stderr.R alone */
+    static const struct {
+        const char* name;
+        int plane, pixel, n;
+        float value;
+    } bad[3] = {{"ref_se_nan.exr", 5, 2 * W + 3, 7, NAN}, {"ref_se_neg.exr", 6, W, 7, -0.01f},
+                {"ref_se_part.exr", 4, 0, 5, 0.02f}};
+    for (int k = 0; k < 3 && ok; ++k) {
+        const float keep = planes[bad[k].plane][bad[k].pixel];
+        planes[bad[k].plane][bad[k].pixel] = bad[k].value;
+        snprintf(path, sizeof path, "%s/%s", dir, bad[k].name);
+        if (veil_write_exr_planes(path, W, H, bad[k].n, names, p, &err) != VEIL_OK) {
+            fprintf(stderr, "make_compare_exrs: %s\n", err.msg);
+            ok = 0;
+        }
+        planes[bad[k].plane][bad[k].pixel] = keep;
     }
     return ok ? 0 : 1;
 }
