@@ -11,7 +11,7 @@
 #               (bench/peers.py: installs libopenvdb-tools and gnuplot; ~30 minutes the
 #               first time, the references then cached; PEERS_ARGS="--quick": minutes)
 #   make fuzz   libFuzzer on the scene parser, the particle readers, the EXR and
-#               the OpenVDB readers, FUZZ_SECONDS each (default 60), under ASan and
+#               the OpenVDB readers, frame patterns and a run's files, FUZZ_SECONDS each (default 60), under ASan and
 #               UBSan, in build-fuzz/ (scripts/fuzz.sh)
 #   make test-sanitize  every test built with AddressSanitizer and UndefinedBehaviorSanitizer
 #                  (undefined behaviour fatal) in build-sanitize/; leaks in Mesa and LLVM
@@ -86,7 +86,7 @@ fuzz:
 	@bash scripts/install-bench-deps.sh clang
 	@CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVEIL_FUZZ=ON \
 	  -DVEIL_SANITIZE=ON >/dev/null
-	@cmake --build build-fuzz -j $(JOBS) --target fuzz_scene fuzz_particles fuzz_exr fuzz_vdb fuzz_nanovdb make_test_vdbs \
+	@cmake --build build-fuzz -j $(JOBS) --target fuzz_scene fuzz_particles fuzz_exr fuzz_vdb fuzz_nanovdb fuzz_paths make_test_vdbs \
 	  make_compare_exrs veil_cli -- --no-print-directory
 	@bash scripts/fuzz.sh build-fuzz $(FUZZ_SECONDS)
 

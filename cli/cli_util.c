@@ -78,41 +78,148 @@ veil_result veil_cli_check_output_folder(const char* path, veil_error* err)
 }
 
 
-/* 1 when a and b name the same existing file, or the same path. */
-static int same_file(const char* a, const char* b)
+int veil_cli_check_run(const veil_run_file* files, int n, const veil_frame_range* range)
 {
-    if (!strcmp(a, b)) return 1;
-    struct stat sa, sb;
-    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    veil_error err = {0};
+    veil_run_clash* clash = malloc(sizeof *clash);
+    if (!clash) return veil_cli_fail(veil_fail(&err, VEIL_ERR_OOM, "out of memory"), &err);
+    veil_result r = veil_run_files_check(files, n, range, 1, clash, &err);
+    int rc = EXIT_OK;
+    if (r != VEIL_OK) {
+        rc = veil_cli_fail(r, &err);
+    } else if (clash->problem != VEIL_RUN_FINE) {
+        char text[VEIL_ERROR_MAX];
+        veil_run_clash_text(files, clash, text, sizeof text);
+        rc = veil_cli_usage_error("%s", text);
+    }
+    free(clash);
+    return rc;
 }
 
 int veil_cli_check_outputs(const char* const* inputs, int n_in, const char* const* outputs, const char* const* names,
                            int n_out)
 {
-    for (int i = 0; i < n_out; ++i) {
-        if (!outputs[i]) continue;
-        char what[160];
-        if (!outputs[i][0]) {
-            snprintf(what, sizeof what, "%s: an empty path", names[i]);
-            return veil_cli_usage_error("%s", what);
-        }
-        struct stat st;
-        if (stat(outputs[i], &st) == 0 && S_ISDIR(st.st_mode)) {
-            snprintf(what, sizeof what, "%s: '%%s' is a directory", names[i]);
-            return veil_cli_usage_error(what, outputs[i]);
-        }
-        for (int j = 0; j < n_in; ++j)
-            if (inputs[j] && same_file(outputs[i], inputs[j])) {
-                snprintf(what, sizeof what, "%s: '%%s' is an input of this run (it would be overwritten)", names[i]);
-                return veil_cli_usage_error(what, outputs[i]);
-            }
-        for (int j = 0; j < i; ++j)
-            if (outputs[j] && same_file(outputs[i], outputs[j])) {
-                snprintf(what, sizeof what, "%s and %s: both are '%%s'", names[j], names[i]);
-                return veil_cli_usage_error(what, outputs[i]);
-            }
+    veil_run_file files[16];
+    int n = 0;
+    for (int i = 0; i < n_in && n < 16; ++i)
+        if (inputs[i]) files[n++] = (veil_run_file){.what = "the input", .path = inputs[i]};
+    for (int i = 0; i < n_out && n < 16; ++i)
+        if (outputs[i]) files[n++] = (veil_run_file){.what = names[i], .path = outputs[i], .writes = 1};
+    return veil_cli_check_run(files, n, NULL);
+}
+
+veil_run_file* veil_cli_scene_inputs(const char* path, const veil_scene* s, int per_frame, int extra, int* n)
+{
+    enum { FIELD = 48, PATH = 4096 };
+    size_t k = veil_scene_files(s, NULL, 0);
+    size_t entries = 1 + k + (size_t)extra;
+    /* the entries, then each file's field name and (frame 1's) path */
+    char* block = calloc(1, entries * sizeof(veil_run_file) + k * (sizeof(veil_scene_file) + FIELD + PATH));
+    if (!block) return NULL;
+    veil_run_file* files = (veil_run_file*)block;
+    veil_scene_file* sf = (veil_scene_file*)(block + entries * sizeof(veil_run_file));
+    char* names = (char*)(sf + k);
+    char* paths = names + k * FIELD;
+    veil_scene_files(s, sf, k);
+    int m = 0;
+    files[m++] = (veil_run_file){.what = "the scene", .path = path};
+    for (size_t i = 0; i < k; ++i) {
+        char* field = names + i * FIELD;
+        snprintf(field, FIELD, "medium.sources[%zu].file", sf[i].source);
+        veil_run_file f = {.what = field, .path = sf[i].path};
+        veil_error err = {0};
+        if (sf[i].sequence && per_frame) f.naming = VEIL_RUN_PATTERN, f.offset = sf[i].frame_offset;
+        else if (sf[i].sequence && veil_scene_file_at(&sf[i], 1, paths + i * PATH, PATH, &err) == VEIL_OK)
+            f.path = paths + i * PATH;
+        else if (sf[i].sequence)
+            continue; /* a name too long to read: nothing to overwrite either */
+        files[m++] = f;
     }
-    return EXIT_OK;
+    *n = m;
+    return files;
+}
+
+/* Appends a copy of dir to the list; 0 when out of memory. */
+static int note_made(veil_cli_folders* m, const char* dir)
+{
+    if (m->n == m->cap) {
+        size_t cap = m->cap ? 2 * m->cap : 8;
+        char** grown = realloc(m->made, cap * sizeof *grown);
+        if (!grown) return 0;
+        m->made = grown, m->cap = cap;
+    }
+    size_t len = strlen(dir) + 1;
+    if (!(m->made[m->n] = malloc(len))) return 0;
+    memcpy(m->made[m->n++], dir, len);
+    return 1;
+}
+
+/* dir and its missing ancestors, as mkdir -p; the ones made noted. */
+static veil_result make_path(const char* what, const char* file, const char* dir, veil_cli_folders* m,
+                             veil_error* err)
+{
+    char part[4096];
+    size_t len = strlen(dir);
+    if (len >= sizeof part) return veil_fail(err, VEIL_ERR_LIMIT, "%s: '%s': the name is too long", what, file);
+    for (size_t k = 1; k <= len; ++k) {
+        if (k < len && dir[k] != '/') continue;
+        if (dir[k - 1] == '/') continue; /* "a//b", the root */
+        memcpy(part, dir, k);
+        part[k] = '\0';
+        struct stat st;
+        if (mkdir(part, 0777) == 0) {
+            if (!note_made(m, part)) return veil_fail(err, VEIL_ERR_OOM, "out of memory");
+        } else if (errno != EEXIST || stat(part, &st) != 0 || !S_ISDIR(st.st_mode)) {
+            int e = errno == EEXIST ? ENOTDIR : errno;
+            return veil_fail(err, VEIL_ERR_IO, "%s: '%s': cannot make the folder '%s': %s", what, file, part,
+                             strerror(e));
+        }
+    }
+    if (access(dir, W_OK | X_OK) != 0)
+        return veil_fail(err, VEIL_ERR_IO, "%s: '%s': cannot write into the folder '%s': %s", what, file, dir,
+                         strerror(errno));
+    return VEIL_OK;
+}
+
+veil_result veil_cli_make_folders(const veil_run_file* files, int n, const veil_frame_range* range,
+                                  veil_cli_folders* made, veil_error* err)
+{
+    veil_result r = VEIL_OK;
+    long count = range ? veil_frame_range_count(range) : 0;
+    veil_temp_hold_signals(); /* made and registered as one step */
+    for (int g = 0; g < n && r == VEIL_OK; ++g) {
+        if (!files[g].writes) continue;
+        char last[4096] = "";
+        long frames = files[g].naming == VEIL_RUN_ONE ? 1 : count;
+        for (long i = 0; i < frames && r == VEIL_OK; ++i) {
+            char path[4096], dir[4096];
+            r = veil_run_file_path(&files[g], files[g].naming == VEIL_RUN_ONE ? 0 : veil_frame_range_at(range, i),
+                                   path, sizeof path, err);
+            const char* slash = r == VEIL_OK ? strrchr(path, '/') : NULL;
+            if (!slash) continue; /* the current folder, or an error */
+            size_t len = slash == path ? 1 : (size_t)(slash - path);
+            memcpy(dir, path, len);
+            dir[len] = '\0';
+            if (!strcmp(dir, last)) continue; /* a pattern's frames share their folder */
+            r = make_path(files[g].what, path, dir, made, err);
+            strcpy(last, dir);
+        }
+    }
+    veil_temp_register_made_folders(made->made, made->n);
+    veil_temp_release_signals();
+    if (r != VEIL_OK) veil_cli_folders_done(made, 0);
+    return r;
+}
+
+void veil_cli_folders_done(veil_cli_folders* made, int ok)
+{
+    veil_temp_forget_made_folders();
+    for (size_t i = made->n; i > 0; --i) {
+        if (!ok) rmdir(made->made[i - 1]); /* only an empty one goes */
+        free(made->made[i - 1]);
+    }
+    free(made->made);
+    memset(made, 0, sizeof *made);
 }
 
 const char* veil_cli_stage(veil_cli_outputs* o, const char* target, veil_error* err)

@@ -3,6 +3,8 @@
 #define VEIL_CLI_UTIL_H
 
 #include "core/result.h"
+#include "run_files.h"
+#include "scene/scene.h"
 
 enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2, EXIT_GPU = 3 };
 
@@ -21,12 +23,41 @@ int veil_cli_parse_float(const char* s, float lo, float hi, float* out);
  * not exist (checked before any work, so nothing is written half). */
 veil_result veil_cli_check_output_folder(const char* path, veil_error* err);
 
+/* The files of a run checked before any work (cli/run_files.h): EXIT_OK,
+ * or EXIT_USAGE with the clash printed (naming both files), or EXIT_INPUT
+ * with the error (a name too long, a folder that cannot be looked into). */
+int veil_cli_check_run(const veil_run_file* files, int n, const veil_frame_range* range);
+
+/* The run's inputs: the scene file `path` ("the scene") and each file s
+ * reads (veil_scene_files, "medium.sources[i].file"): a sequence's pattern
+ * followed over the run's frames (per_frame), or its file of frame 1 (the
+ * commands that render that frame of it). In one block with room for
+ * `extra` more entries after the *n made; free() it. NULL: out of memory. */
+veil_run_file* veil_cli_scene_inputs(const char* path, const veil_scene* s, int per_frame, int extra, int* n);
+
+/* The folders of a run's outputs, made before the first frame as mkdir -p
+ * does (film tools make a frames/ folder), and each checked writable:
+ * VEIL_ERR_IO naming the option and the folder otherwise. Those it made
+ * are listed (and registered, io/tempfile.h: a signal removes them when
+ * empty). `range`: the frames this process writes (a shard's). */
+typedef struct veil_cli_folders {
+    char** made;
+    size_t n, cap;
+} veil_cli_folders;
+veil_result veil_cli_make_folders(const veil_run_file* files, int n, const veil_frame_range* range,
+                                  veil_cli_folders* made, veil_error* err);
+/* ok: the folders stay; else those made that are still empty are removed,
+ * the last made first (a failed run leaves no folder it made for nothing). */
+void veil_cli_folders_done(veil_cli_folders* made, int ok);
+
 /* Usage checks of the output paths before any work (exit 2, naming the
  * option): none empty, no two the same file (the same path, or an existing
  * file under two names), none an input file (a scene, a frame: the run
- * would overwrite what it reads), none an existing directory. inputs and
- * outputs: n strings each, NULL entries skipped; names: each output's
- * option ("-o", "--png"). Returns EXIT_OK or EXIT_USAGE (message printed). */
+ * would overwrite what it reads), none an existing directory: the run's
+ * files as veil_cli_check_run checks them, each a file of its own. inputs
+ * and outputs: n strings each (16 in all at most), NULL entries skipped;
+ * names: each output's option ("-o", "--png"). Returns EXIT_OK, EXIT_USAGE
+ * or EXIT_INPUT (message printed). */
 int veil_cli_check_outputs(const char* const* inputs, int n_in, const char* const* outputs, const char* const* names,
                            int n_out);
 

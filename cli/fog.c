@@ -144,14 +144,31 @@ int veil_cmd_fog(int argc, char** argv)
     float *frame = NULL, *depth = NULL;
     int w = 0, h = 0;
     const char* channel = NULL;
-    const char* ins[2] = {a.frame, a.scene};
-    const char* outs[2] = {a.exr, a.png};
-    const char* names[2] = {"-o", "--png"};
-    rc = veil_cli_check_outputs(ins, 2, outs, names, 2);
-    if (rc != EXIT_OK) return rc;
-    veil_result r = veil_cli_check_output_folder(a.exr, &err);
-    if (r == VEIL_OK && a.png) r = veil_cli_check_output_folder(a.png, &err);
-    if (r == VEIL_OK) r = veil_scene_load(a.scene, &scene, &err);
+    veil_result r = veil_scene_load(a.scene, &scene, &err);
+    if (r != VEIL_OK) return veil_cli_fail(r, &err);
+    /* -o and --png against the frame, the scene and what it reads (cli/run_files.h), then their folders */
+    int n = 0;
+    veil_run_file* files = veil_cli_scene_inputs(a.scene, &scene, 0, 3, &n);
+    if (!files) {
+        veil_scene_free(&scene);
+        return veil_cli_fail(veil_fail(&err, VEIL_ERR_OOM, "out of memory"), &err);
+    }
+    char staged[48];
+    snprintf(staged, sizeof staged, ".veil-staged%ld", (long)getpid()); /* veil_cli_stage's */
+    files[n++] = (veil_run_file){.what = "the frame", .path = a.frame};
+    files[n++] = (veil_run_file){.what = "-o", .path = a.exr, .writes = 1, .staged = staged};
+    if (a.png) files[n++] = (veil_run_file){.what = "--png", .path = a.png, .writes = 1, .staged = staged};
+    veil_cli_folders made = {0};
+    rc = veil_cli_check_run(files, n, NULL);
+    if (rc == EXIT_OK) {
+        r = veil_cli_make_folders(files, n, NULL, &made, &err);
+        if (r != VEIL_OK) rc = veil_cli_fail(r, &err);
+    }
+    free(files);
+    if (rc != EXIT_OK) {
+        veil_scene_free(&scene);
+        return rc;
+    }
     if (r == VEIL_OK) r = veil_read_exr(a.frame, &w, &h, &frame, &err);
     if (r == VEIL_OK && (w != scene.camera.width || h != scene.camera.height))
         r = veil_fail(&err, VEIL_ERR_INVALID, "%s is %dx%d but the scene %s's camera is %dx%d (camera.width, "
@@ -199,5 +216,6 @@ int veil_cmd_fog(int argc, char** argv)
     veil_scene_free(&scene);
     free(frame);
     free(depth);
+    veil_cli_folders_done(&made, r == VEIL_OK);
     return r == VEIL_OK ? EXIT_OK : veil_cli_fail(r, &err);
 }

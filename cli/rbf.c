@@ -88,16 +88,26 @@ int veil_cmd_rbf(int argc, char** argv)
         size_t n = strlen(out);
         format = !(n >= 5 && !strcmp(out + n - 5, ".json"));
     }
+    /* -o: a file of its own (not a directory, a FIFO), its folder made (cli/run_files.h) */
+    const veil_run_file file = {.what = "-o", .path = out, .writes = 1};
+    int rc = veil_cli_check_run(&file, 1, NULL);
+    if (rc != EXIT_OK) return rc;
+    veil_error err = {0};
+    veil_cli_folders made = {0};
+    veil_result r = veil_cli_make_folders(&file, 1, NULL, &made, &err);
+    if (r != VEIL_OK) return veil_cli_fail(r, &err);
     veil_rbf_random_desc d = {.count = (uint32_t)count, .seed = (uint64_t)seed,
                               .bounds = {{bounds[0], bounds[1], bounds[2]}, {bounds[3], bounds[4], bounds[5]}},
                               .radius = {radius[0], radius[1]}, .amplitude = {amp[0], amp[1]}};
     veil_particle* p = count ? malloc((size_t)count * sizeof *p) : NULL;
-    veil_error err = {0};
-    if (count && !p) return veil_cli_fail(veil_fail(&err, VEIL_ERR_OOM, "out of memory for %ld particles", count), &err);
-    veil_rbf_random_generate(&d, p);
-    veil_particles_modulate(p, (size_t)count, (uint64_t)seed, scale, (int)octaves, amount);
-    veil_result r = veil_particles_write(out, p, (size_t)count, (int)format, &err);
+    if (count && !p) r = veil_fail(&err, VEIL_ERR_OOM, "out of memory for %ld particles", count);
+    if (r == VEIL_OK) {
+        veil_rbf_random_generate(&d, p);
+        veil_particles_modulate(p, (size_t)count, (uint64_t)seed, scale, (int)octaves, amount);
+        r = veil_particles_write(out, p, (size_t)count, (int)format, &err);
+    }
     free(p);
+    veil_cli_folders_done(&made, r == VEIL_OK);
     if (r != VEIL_OK) return veil_cli_fail(r, &err);
     printf("wrote %s (%ld particles, %s)\n", out, count, format ? "binary" : "json");
     return EXIT_OK;

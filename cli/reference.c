@@ -130,15 +130,27 @@ int veil_cmd_reference(int argc, char** argv)
     if (code >= 0) return code;
     veil_error err = {0};
     veil_scene scene;
-    const char* ins[1] = {a.scene};
-    const char* outs[1] = {a.exr};
-    const char* opts[1] = {"-o"};
-    code = veil_cli_check_outputs(ins, 1, outs, opts, 1);
-    if (code != EXIT_OK) return code;
-    veil_result r = veil_cli_check_output_folder(a.exr, &err);
+    veil_result r = veil_scene_load(a.scene, &scene, &err);
     if (r != VEIL_OK) return veil_cli_fail(r, &err);
-    r = veil_scene_load(a.scene, &scene, &err);
-    if (r != VEIL_OK) return veil_cli_fail(r, &err);
+    /* -o against the scene and what it reads (cli/run_files.h), then its folder, made */
+    int n_files = 0;
+    veil_run_file* files = veil_cli_scene_inputs(a.scene, &scene, 0, 1, &n_files);
+    if (!files) {
+        veil_scene_free(&scene);
+        return veil_cli_fail(veil_fail(&err, VEIL_ERR_OOM, "out of memory"), &err);
+    }
+    files[n_files++] = (veil_run_file){.what = "-o", .path = a.exr, .writes = 1};
+    veil_cli_folders made = {0};
+    code = veil_cli_check_run(files, n_files, NULL);
+    if (code == EXIT_OK) {
+        r = veil_cli_make_folders(files, n_files, NULL, &made, &err);
+        if (r != VEIL_OK) code = veil_cli_fail(r, &err);
+    }
+    free(files);
+    if (code != EXIT_OK) {
+        veil_scene_free(&scene);
+        return code;
+    }
     veil_pt_medium* m = NULL;
     r = veil_pt_medium_from_scene(&scene, &m, &err);
     if (r != VEIL_OK) veil_cli_prefix_error(&err, a.scene);
@@ -208,5 +220,6 @@ int veil_cmd_reference(int argc, char** argv)
     free(se);
     veil_pt_medium_free(m);
     veil_scene_free(&scene);
+    veil_cli_folders_done(&made, r == VEIL_OK);
     return r == VEIL_OK ? EXIT_OK : veil_cli_fail(r, &err);
 }

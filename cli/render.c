@@ -109,27 +109,35 @@ int veil_cmd_render(int argc, char** argv)
     double t_start = veil_now_ms();
     veil_error err = {0};
     veil_scene scene;
-    const char* ins[1] = {a.scene};
-    const char* outs[2] = {a.exr, a.png};
-    const char* names[2] = {"-o", "--png"};
-    rc = veil_cli_check_outputs(ins, 1, outs, names, 2);
-    if (rc != EXIT_OK) return rc;
-    /* --turntable N writes OUT_0000.exr ...: every frame's files, not only the names given, are checked
-     * against the scene and each other before any work (issue 22: s_0001.json was overwritten) */
-    for (long f = 0; a.frames > 0 && f < a.frames; ++f) {
-        char fe[4096], fp[4096];
-        veil_result fr = veil_frame_path(a.exr, f, 1, fe, sizeof fe, &err);
-        if (fr == VEIL_OK && a.png) fr = veil_frame_path(a.png, f, 1, fp, sizeof fp, &err);
-        if (fr != VEIL_OK) return veil_cli_fail(fr, &err);
-        const char* fouts[2] = {fe, a.png ? fp : NULL};
-        rc = veil_cli_check_outputs(ins, 1, fouts, names, 2);
-        if (rc != EXIT_OK) return rc;
+    veil_result r = veil_scene_load(a.scene, &scene, &err);
+    if (r != VEIL_OK) return veil_cli_fail(r, &err);
+    /* the run's files before any work (cli/run_files.h): the scene and what it reads, every frame's EXR and
+     * PNG of --turntable N (OUT_0000.exr ...) and their staging names (issue 22: s_0001.json was
+     * overwritten); then their folders, made */
+    int n = 0;
+    veil_run_file* files = veil_cli_scene_inputs(a.scene, &scene, 0, 2, &n);
+    if (!files) {
+        veil_scene_free(&scene);
+        return veil_cli_fail(veil_fail(&err, VEIL_ERR_OOM, "out of memory"), &err);
     }
-    veil_result r = veil_cli_check_output_folder(a.exr, &err);
-    if (r == VEIL_OK && a.png) r = veil_cli_check_output_folder(a.png, &err);
-    if (r != VEIL_OK) return veil_cli_fail(r, &err);
-    r = veil_scene_load(a.scene, &scene, &err);
-    if (r != VEIL_OK) return veil_cli_fail(r, &err);
+    char staged[48];
+    snprintf(staged, sizeof staged, ".veil-staged%ld", (long)getpid()); /* veil_cli_stage's */
+    veil_run_naming naming = a.frames > 0 ? VEIL_RUN_NUMBERED : VEIL_RUN_ONE;
+    files[n++] = (veil_run_file){.what = "-o", .path = a.exr, .naming = naming, .writes = 1, .staged = staged};
+    if (a.png)
+        files[n++] = (veil_run_file){.what = "--png", .path = a.png, .naming = naming, .writes = 1, .staged = staged};
+    const veil_frame_range turntable = {0, a.frames - 1, 1};
+    veil_cli_folders made = {0};
+    rc = veil_cli_check_run(files, n, a.frames > 0 ? &turntable : NULL);
+    if (rc == EXIT_OK) {
+        r = veil_cli_make_folders(files, n, a.frames > 0 ? &turntable : NULL, &made, &err);
+        if (r != VEIL_OK) rc = veil_cli_fail(r, &err);
+    }
+    free(files);
+    if (rc != EXIT_OK) {
+        veil_scene_free(&scene);
+        return rc;
+    }
 
     veil_gl* gl = NULL;
     veil_renderer* ren = NULL;
@@ -168,5 +176,6 @@ int veil_cmd_render(int argc, char** argv)
     veil_renderer_destroy(ren);
     veil_gl_destroy(gl);
     veil_scene_free(&scene);
+    veil_cli_folders_done(&made, r == VEIL_OK); /* failed: the folders it made for nothing go */
     return r == VEIL_OK ? EXIT_OK : veil_cli_fail(r, &err);
 }

@@ -10,12 +10,17 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#ifdef __linux__
+#include <sys/prctl.h>
+#endif
 
 #include "cli_util.h"
 #include "io/image.h"
+#include "io/tempfile.h"
 
 /* The frame's EXR as 8-bit sRGB (the PNG preview's tone curve), newly malloc'd. */
 static veil_result frame_rgb8(const char* exr, int* w, int* h, unsigned char** rgb, veil_error* err)
@@ -83,7 +88,7 @@ veil_result veil_review_contact_sheet(const char* const* frames, int n, const ch
     return r;
 }
 
-/* ffmpeg on PATH: its path into out (n bytes), 1; else 0. */
+/* name on PATH: its path into out (n bytes), 1; else 0. */
 static int find_program(const char* name, char* out, size_t n)
 {
     const char* path = getenv("PATH");
@@ -98,6 +103,78 @@ static int find_program(const char* name, char* out, size_t n)
     return 0;
 }
 
+int veil_review_find_ffmpeg(char* out, size_t n) { return find_program("ffmpeg", out, n); }
+
+void veil_review_movie_names(const char* out, char* staged, size_t ns, char* frames_dir, size_t nd)
+{
+    const char* dot = strrchr(out, '.');
+    const char* slash = strrchr(out, '/');
+    if (!dot || (slash && dot < slash)) dot = "";
+    snprintf(staged, ns, "%s.veil-staged%ld%s", out, (long)getpid(), dot); /* ffmpeg picks the format by it */
+    snprintf(frames_dir, nd, "%s.veil-frames%ld", out, (long)getpid());
+}
+
+/* The frames' PNGs in the folder: "f000000.png", ... (ffmpeg's image-sequence input "f%06d.png"). */
+#define FRAME_PREFIX "f"
+#define FRAME_DIGITS 6
+#define FRAME_SUFFIX ".png"
+
+/* ffmpeg on the folder's frames into staged; VEIL_OK when it exits 0. */
+static veil_result run_ffmpeg(const char* ffmpeg, const char* dir, int gif, double fps, const char* staged,
+                              const char* out, veil_error* err)
+{
+    char pattern[4400], rate[32];
+    snprintf(pattern, sizeof pattern, "%s/" FRAME_PREFIX "%%0%dd" FRAME_SUFFIX, dir, FRAME_DIGITS);
+    snprintf(rate, sizeof rate, "%g", fps);
+    const char* argv_mp4[] = {ffmpeg, "-nostdin", "-y", "-loglevel", "error", "-framerate", rate, "-i", pattern,
+                              "-vf", "scale=trunc(iw/2)*2:trunc(ih/2)*2", "-pix_fmt", "yuv420p", staged, NULL};
+    const char* argv_gif[] = {ffmpeg, "-nostdin", "-y", "-loglevel", "error", "-framerate", rate, "-i", pattern,
+                              "-vf", "split[a][b];[a]palettegen[p];[b][p]paletteuse", staged, NULL};
+    /* the child in a process group of its own, registered before a signal can be handled: the handler
+     * (io/tempfile.h) ends the group and reaps it before it removes the files ffmpeg writes */
+    veil_temp_hold_signals();
+    pid_t parent = getpid();
+    pid_t pid = fork();
+    if (pid == 0) {
+        setpgid(0, 0);
+        signal(SIGINT, SIG_DFL);
+        signal(SIGTERM, SIG_DFL);
+#ifdef __linux__
+        prctl(PR_SET_PDEATHSIG, SIGTERM); /* and if veil is killed outright (SIGKILL), ffmpeg ends too */
+        if (getppid() != parent) _exit(127); /* it was, before that */
+#endif
+        veil_temp_release_signals();
+        execv(ffmpeg, (char* const*)(gif ? argv_gif : argv_mp4));
+        _exit(127);
+    }
+    if (pid > 0) {
+        setpgid(pid, pid); /* as the child does: whichever runs first */
+        veil_temp_register_child(pid);
+    }
+    veil_temp_release_signals();
+    int status = 0;
+    veil_result r = VEIL_OK;
+    int waited = pid > 0 ? (int)waitpid(pid, &status, 0) : -1;
+    veil_temp_forget_child();
+    if (waited < 0)
+        r = veil_fail(err, VEIL_ERR_IO, "%s: cannot run %s: %s", out, ffmpeg, strerror(errno));
+    else if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        r = veil_fail(err, VEIL_ERR_IO, "%s: ffmpeg failed (%s %d); its messages are above", out,
+                      WIFEXITED(status) ? "exit" : "signal", WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
+    return r;
+}
+
+/* Removes the folder's first n frames, then the folder. */
+static void remove_frames(const char* dir, int n)
+{
+    for (int k = 0; k < n; ++k) {
+        char png[4400];
+        snprintf(png, sizeof png, "%s/" FRAME_PREFIX "%0*d" FRAME_SUFFIX, dir, FRAME_DIGITS, k);
+        unlink(png);
+    }
+    rmdir(dir);
+}
+
 veil_result veil_review_movie(const char* const* frames, int n, double fps, const char* out, veil_error* err)
 {
     char ffmpeg[4096];
@@ -108,51 +185,38 @@ veil_result veil_review_movie(const char* const* frames, int n, double fps, cons
     int gif = dot && !strcmp(dot, ".gif");
     if (!dot || (!gif && strcmp(dot, ".mp4") && strcmp(dot, ".mov") && strcmp(dot, ".mkv")))
         return veil_fail(err, VEIL_ERR_INVALID, "%s: a movie is .mp4, .mov, .mkv or .gif", out);
-    /* the frames as numbered PNGs in a folder beside the movie, ffmpeg's image-sequence input */
-    char dir[4200], pattern[4300], staged[4200];
-    snprintf(dir, sizeof dir, "%s.veil-frames%ld", out, (long)getpid());
-    snprintf(staged, sizeof staged, "%s.veil-staged%ld%s", out, (long)getpid(), dot);
-    if (mkdir(dir, 0700) != 0) return veil_fail(err, VEIL_ERR_IO, "%s: cannot make %s: %s", out, dir, strerror(errno));
+    /* the frames as numbered PNGs in a folder beside the movie, ffmpeg's image-sequence input; the folder,
+     * its frames and the staged movie registered, for a signal to remove them (io/tempfile.h) */
+    char dir[4200], staged[4200];
+    veil_review_movie_names(out, staged, sizeof staged, dir, sizeof dir);
+    veil_temp_hold_signals();
+    int made = mkdir(dir, 0700) == 0;
+    int e = errno;
+    if (made) veil_temp_register_folder(dir, FRAME_PREFIX, FRAME_DIGITS, FRAME_SUFFIX);
+    veil_temp_release_signals();
+    if (!made) return veil_fail(err, VEIL_ERR_IO, "%s: cannot make %s: %s", out, dir, strerror(e));
     veil_result r = VEIL_OK;
+    int written = 0;
     for (int k = 0; k < n && r == VEIL_OK; ++k) {
         int w, h;
         unsigned char* rgb;
         r = frame_rgb8(frames[k], &w, &h, &rgb, err);
         if (r == VEIL_OK) {
             char png[4400];
-            snprintf(png, sizeof png, "%s/f%06d.png", dir, k);
+            snprintf(png, sizeof png, "%s/" FRAME_PREFIX "%0*d" FRAME_SUFFIX, dir, FRAME_DIGITS, k);
+            veil_temp_folder_count(k + 1); /* before it exists, as the temporaries */
+            written = k + 1;
             r = veil_write_png_rgb8(png, w, h, rgb, err);
         }
         free(rgb);
     }
-    if (r == VEIL_OK) {
-        snprintf(pattern, sizeof pattern, "%s/f%%06d.png", dir);
-        char rate[32];
-        snprintf(rate, sizeof rate, "%g", fps);
-        const char* argv_mp4[] = {ffmpeg, "-nostdin", "-y", "-loglevel", "error", "-framerate", rate, "-i", pattern,
-                                  "-vf", "scale=trunc(iw/2)*2:trunc(ih/2)*2", "-pix_fmt", "yuv420p", staged, NULL};
-        const char* argv_gif[] = {ffmpeg, "-nostdin", "-y", "-loglevel", "error", "-framerate", rate, "-i", pattern,
-                                  "-vf", "split[a][b];[a]palettegen[p];[b][p]paletteuse", staged, NULL};
-        pid_t pid = fork();
-        if (pid == 0) {
-            execv(ffmpeg, (char* const*)(gif ? argv_gif : argv_mp4));
-            _exit(127);
-        }
-        int status = 0;
-        if (pid < 0 || waitpid(pid, &status, 0) < 0)
-            r = veil_fail(err, VEIL_ERR_IO, "%s: cannot run %s: %s", out, ffmpeg, strerror(errno));
-        else if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-            r = veil_fail(err, VEIL_ERR_IO, "%s: ffmpeg failed (%s %d); its messages are above", out,
-                          WIFEXITED(status) ? "exit" : "signal", WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
-        else if (rename(staged, out) != 0)
-            r = veil_fail(err, VEIL_ERR_IO, "%s: cannot move %s into place: %s", out, staged, strerror(errno));
-    }
+    veil_temp_register(staged); /* ffmpeg writes it */
+    if (r == VEIL_OK) r = run_ffmpeg(ffmpeg, dir, gif, fps, staged, out, err);
+    if (r == VEIL_OK && rename(staged, out) != 0)
+        r = veil_fail(err, VEIL_ERR_IO, "%s: cannot move %s into place: %s", out, staged, strerror(errno));
     unlink(staged);
-    for (int k = 0; k < n; ++k) {
-        char png[4400];
-        snprintf(png, sizeof png, "%s/f%06d.png", dir, k);
-        unlink(png);
-    }
-    rmdir(dir);
+    veil_temp_forget(staged);
+    remove_frames(dir, written);
+    veil_temp_forget_folder();
     return r;
 }

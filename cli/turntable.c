@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "cli_util.h"
 #include "commands.h"
@@ -154,10 +155,72 @@ static int exists(const char* path)
     return stat(path, &st) == 0 && S_ISREG(st.st_mode);
 }
 
+/* A regular file that begins with `magic` (n bytes): a frame --skip-existing may count as done. A file of
+ * another kind under the frame's name (a PNG written there by a clash of names, issue 22) is not. */
+static int exists_as(const char* path, const unsigned char* magic, size_t n)
+{
+    unsigned char head[8];
+    FILE* f = exists(path) ? fopen(path, "rb") : NULL;
+    if (!f) return 0;
+    int ok = n <= sizeof head && fread(head, 1, n, f) == n && !memcmp(head, magic, n);
+    fclose(f);
+    return ok;
+}
+
+static const unsigned char EXR_MAGIC[4] = {0x76, 0x2f, 0x31, 0x01};                       /* OpenEXR's */
+static const unsigned char PNG_MAGIC[8] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a}; /* PNG's signature */
+
+/* The files of the run, checked before any frame (cli/run_files.h): the scene and every file it reads over
+ * the range, each frame's EXR and PNG and their staging names, the contact sheet, the movie and its
+ * scratch names; then the review outputs' limits and ffmpeg; then the outputs' folders, made. */
+static int prepare_files(const tt_args* a, const veil_scene* scene, long count, veil_cli_folders* made)
+{
+    if ((a->movie || a->sheet) && count > VEIL_REVIEW_MAX_FRAMES) {
+        char what[160];
+        snprintf(what, sizeof what, "%s: the range has %ld frames; a movie or a contact sheet takes at most %d",
+                 a->movie ? "--movie" : "--contact-sheet", count, VEIL_REVIEW_MAX_FRAMES);
+        return veil_cli_usage_error("%s", what);
+    }
+    int n = 0;
+    veil_run_file* files = veil_cli_scene_inputs(a->scene, scene, 1, 6, &n);
+    veil_error err = {0};
+    if (!files) return veil_cli_fail(veil_fail(&err, VEIL_ERR_OOM, "out of memory"), &err);
+    char staged[48], movie_staged[4200], movie_frames[4200];
+    snprintf(staged, sizeof staged, ".veil-staged%ld", (long)getpid()); /* veil_cli_stage's */
+    files[n++] = (veil_run_file){.what = "-o", .path = a->exr, .naming = VEIL_RUN_PATTERN, .writes = 1,
+                                 .staged = staged};
+    if (a->png)
+        files[n++] = (veil_run_file){.what = "--png", .path = a->png, .naming = VEIL_RUN_PATTERN, .writes = 1,
+                                     .staged = staged};
+    if (a->sheet) files[n++] = (veil_run_file){.what = "--contact-sheet", .path = a->sheet, .writes = 1};
+    if (a->movie) {
+        veil_review_movie_names(a->movie, movie_staged, sizeof movie_staged, movie_frames, sizeof movie_frames);
+        files[n++] = (veil_run_file){.what = "--movie", .path = a->movie, .writes = 1};
+        files[n++] = (veil_run_file){.what = "--movie's staging file", .path = movie_staged, .writes = 1};
+        files[n++] = (veil_run_file){.what = "--movie's folder of frames", .path = movie_frames, .writes = 1,
+                                     .scratch = 1};
+    }
+    /* every frame of the range, whichever shard renders it: the shards are one run */
+    int rc = veil_cli_check_run(files, n, &a->range);
+    char ffmpeg[4096];
+    if (rc == EXIT_OK && a->movie && !veil_review_find_ffmpeg(ffmpeg, sizeof ffmpeg))
+        rc = veil_cli_fail(veil_fail(&err, VEIL_ERR_IO, "%s: a movie needs the ffmpeg program (Debian package ffmpeg), "
+                                     "and there is none on PATH; nothing was rendered", a->movie), &err);
+    /* the folders of this shard's frames and of the review outputs */
+    veil_frame_range mine = {a->range.first + (a->shard - 1) * a->range.step, a->range.last,
+                             a->range.step * a->shards};
+    veil_result r = VEIL_OK;
+    if (rc == EXIT_OK) r = veil_cli_make_folders(files, n, mine.first <= mine.last ? &mine : NULL, made, &err);
+    if (r != VEIL_OK) rc = veil_cli_fail(r, &err);
+    free(files);
+    return rc;
+}
+
 /* The contact sheet and the movie, from every frame of the range (rendered by this run or others). */
 static veil_result review(const tt_args* a, long count, veil_error* err)
 {
-    if (count > 100000) return veil_fail(err, VEIL_ERR_LIMIT, "a movie or sheet of %ld frames: at most 100000", count);
+    if (count > VEIL_REVIEW_MAX_FRAMES) /* refused before any frame (prepare_files): kept for the sizes below */
+        return veil_fail(err, VEIL_ERR_LIMIT, "a movie or sheet of %ld frames: at most %d", count, VEIL_REVIEW_MAX_FRAMES);
     char** names = calloc((size_t)count, sizeof *names);
     if (!names) return veil_fail(err, VEIL_ERR_OOM, "out of memory");
     veil_result r = VEIL_OK;
@@ -227,48 +290,11 @@ int veil_cmd_turntable(int argc, char** argv)
         if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
         return r == VEIL_OK ? EXIT_OK : veil_cli_fail(r, &err);
     }
-    /* every frame of this run: no file of it is the scene, and a frame's EXR is never its PNG (issue 22:
-     * -o 'f#.exr' --png 'f##.exr' made frame 10's two files one; 's#.json' overwrote s2.json) */
-    for (long i = a.shard - 1; i < count; i += a.shards) {
-        long frame = veil_frame_range_at(&a.range, i);
-        char fe[4096], fp[4096];
-        r = veil_frame_pattern_path(a.exr, frame, fe, sizeof fe, &err);
-        if (r == VEIL_OK && a.png) r = veil_frame_pattern_path(a.png, frame, fp, sizeof fp, &err);
-        if (r != VEIL_OK) {
-            veil_scene_free(&scene);
-            return veil_cli_fail(r, &err);
-        }
-        const char* ins[1] = {a.scene};
-        const char* outs[2] = {fe, a.png ? fp : NULL};
-        const char* names[2] = {"-o", "--png"};
-        rc = veil_cli_check_outputs(ins, 1, outs, names, 2);
-        if (rc != EXIT_OK) {
-            veil_scene_free(&scene);
-            return rc;
-        }
-    }
-    /* the first frame's files stand for all: folders exist */
-    char first_exr[4096], first_png[4096];
-    r = veil_frame_pattern_path(a.exr, a.range.first, first_exr, sizeof first_exr, &err);
-    if (r == VEIL_OK && a.png) r = veil_frame_pattern_path(a.png, a.range.first, first_png, sizeof first_png, &err);
-    if (r == VEIL_OK) {
-        const char* ins[1] = {a.scene};
-        const char* outs[2] = {first_exr, a.png ? first_png : NULL};
-        const char* names[2] = {"-o", "--png"};
-        rc = veil_cli_check_outputs(ins, 1, outs, names, 2);
-        if (rc != EXIT_OK) {
-            veil_scene_free(&scene);
-            return rc;
-        }
-        r = veil_cli_check_output_folder(first_exr, &err);
-    }
-    if (r == VEIL_OK && a.png) r = veil_cli_check_output_folder(first_png, &err);
-    /* and the review outputs' folders, before hours of frames rather than after */
-    if (r == VEIL_OK && a.sheet) r = veil_cli_check_output_folder(a.sheet, &err);
-    if (r == VEIL_OK && a.movie) r = veil_cli_check_output_folder(a.movie, &err);
-    if (r != VEIL_OK) {
+    veil_cli_folders made = {0};
+    rc = prepare_files(&a, &scene, count, &made);
+    if (rc != EXIT_OK) {
         veil_scene_free(&scene);
-        return veil_cli_fail(r, &err);
+        return rc;
     }
     double t_start = veil_now_ms();
     const uint64_t scene_hash = file_hash(a.scene);
@@ -284,7 +310,8 @@ int veil_cmd_turntable(int argc, char** argv)
         r = veil_frame_pattern_path(a.exr, frame, exr, sizeof exr, &err);
         if (r == VEIL_OK && a.png) r = veil_frame_pattern_path(a.png, frame, png, sizeof png, &err);
         if (r != VEIL_OK) break;
-        if (a.skip_existing && exists(exr) && (!a.png || exists(png))) { /* complete: frames are renamed into place */
+        /* complete: frames are renamed into place, so an EXR and a PNG there are whole */
+        if (a.skip_existing && exists_as(exr, EXR_MAGIC, 4) && (!a.png || exists_as(png, PNG_MAGIC, 8))) {
             ++skipped;
             continue;
         }
@@ -372,5 +399,6 @@ int veil_cmd_turntable(int argc, char** argv)
     veil_renderer_destroy(ren);
     veil_gl_destroy(gl);
     veil_scene_free(&scene);
+    veil_cli_folders_done(&made, r == VEIL_OK); /* failed: the folders it made for nothing go */
     return r == VEIL_OK ? EXIT_OK : veil_cli_fail(r, &err);
 }

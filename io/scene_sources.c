@@ -131,7 +131,8 @@ static veil_result parse_rbf(const ctx* c, const cJSON* so, const jpath* sp, vei
             if (code == VEIL_ERR_OOM || code == VEIL_ERR_LIMIT || code == VEIL_ERR_IO) r = code; /* same message */
         }
     }
-    free(path);
+    if (r == VEIL_OK) src->particle_file = path; /* an input of the run (veil_scene_files) */
+    else free(path);
     return r;
 }
 

@@ -13,6 +13,7 @@ void veil_scene_free(veil_scene* s)
     if (!s) return;
     for (size_t i = 0; i < s->medium.source_count; ++i) {
         free(s->medium.sources[i].particles);
+        free(s->medium.sources[i].particle_file);
         free(s->medium.sources[i].vdb.file);
         free(s->medium.sources[i].vdb.sequence);
         free(s->medium.sources[i].vdb.grid);
@@ -169,5 +170,33 @@ veil_result veil_scene_set_frame(veil_scene* s, long frame, veil_error* err)
         free(v->file);
         v->file = copy;
     }
+    return VEIL_OK;
+}
+
+size_t veil_scene_files(const veil_scene* s, veil_scene_file* out, size_t n)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < s->medium.source_count; ++i) {
+        const veil_source* src = &s->medium.sources[i];
+        veil_scene_file f = {.source = i};
+        if (src->type == VEIL_SOURCE_VDB && src->vdb.sequence)
+            f.path = src->vdb.sequence, f.sequence = 1, f.frame_offset = src->vdb.frame_offset;
+        else if (src->type == VEIL_SOURCE_VDB)
+            f.path = src->vdb.file;
+        else if (src->type == VEIL_SOURCE_RBF)
+            f.path = src->particle_file;
+        if (!f.path) continue;
+        if (k < n) out[k] = f;
+        ++k;
+    }
+    return k;
+}
+
+veil_result veil_scene_file_at(const veil_scene_file* f, long frame, char* out, size_t n, veil_error* err)
+{
+    if (f->sequence) return veil_frame_pattern_path(f->path, frame + f->frame_offset, out, n, err);
+    size_t len = strlen(f->path);
+    if (len >= n) return veil_fail(err, VEIL_ERR_LIMIT, "'%s': the name is too long", f->path);
+    memcpy(out, f->path, len + 1);
     return VEIL_OK;
 }

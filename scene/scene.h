@@ -91,6 +91,7 @@ typedef struct veil_source {
     /* VEIL_SOURCE_RBF: explicit particles (owned) */
     veil_particle* particles;
     size_t particle_count;
+    char* particle_file; /* the particle file they were read from, resolved (owned); NULL: inline */
     /* VEIL_SOURCE_RBF_RANDOM */
     veil_rbf_random_desc random;
     /* VEIL_SOURCE_VDB */
@@ -230,6 +231,22 @@ void veil_scene_free(veil_scene* s); /* accepts NULL and zeroed scenes */
 veil_result veil_scene_set_frame(veil_scene* s, long frame, veil_error* err);
 /* 1 when some source of s is a sequence. */
 int veil_scene_is_sequence(const veil_scene* s);
+
+/* A file a scene reads besides itself: a VDB source's file or a sequence's
+ * frame pattern, or an RBF source's particle file (points into the scene). */
+typedef struct veil_scene_file {
+    size_t source;     /* medium.sources[source].file */
+    const char* path;  /* the file; a sequence's pattern when `sequence` */
+    int sequence;      /* 1: frame f reads the pattern's frame f + frame_offset */
+    long frame_offset;
+} veil_scene_file;
+/* The files s reads, in the order of its sources, into out[0 .. n);
+ * returns how many there are (n = 0 counts them). No file is opened. */
+size_t veil_scene_files(const veil_scene* s, veil_scene_file* out, size_t n);
+/* The file f names for frame `frame` (a sequence's: the pattern's frame
+ * frame + frame_offset; otherwise f->path). VEIL_ERR_LIMIT when it does
+ * not fit in n bytes. */
+veil_result veil_scene_file_at(const veil_scene_file* f, long frame, char* out, size_t n, veil_error* err);
 
 /* All particles of all RBF sources (explicit and generated), newly
  * allocated into *out (free() it). */

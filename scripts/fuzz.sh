@@ -39,7 +39,7 @@ done
 fails=0
 export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 export LSAN_OPTIONS=suppressions=$root/tests/support/lsan.supp:print_suppressions=0
-for t in scene particles exr vdb nanovdb; do
+for t in scene particles exr vdb nanovdb paths; do
     mkdir -p "$build/corpus/$t"
     dirs=("$build/corpus/$t")
     [ -d "$root/tests/fuzz/corpus/$t" ] && dirs+=("$root/tests/fuzz/corpus/$t")

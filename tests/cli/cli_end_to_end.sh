@@ -18,8 +18,9 @@ fail() { echo "FAIL: $*"; exit 1; }
 "$veil" --help | grep -q 'usage: veil render' || fail "--help"
 "$veil" render >/dev/null 2>&1; [ $? -eq 2 ] || fail "render without arguments must exit 2"
 "$veil" render "$scene" -o "$tmp/x.exr" --width 0 2>/dev/null; [ $? -eq 2 ] || fail "--width 0 must exit 2"
-"$veil" render "$scene" -o "$tmp/no/such/dir/x.exr" 2> "$tmp/nodir.err"; [ $? -eq 1 ] || fail "missing output folder must exit 1"
-grep -q "the folder '$tmp/no/such/dir' does not exist" "$tmp/nodir.err" || fail "missing folder message: $(cat "$tmp/nodir.err")"
+touch "$tmp/plain" # an output's folder that is a file: usage, before any work (a missing one is made)
+"$veil" render "$scene" -o "$tmp/plain/dir/x.exr" 2> "$tmp/nodir.err"; [ $? -eq 2 ] || fail "an output folder under a file must exit 2"
+grep -q "its folder '$tmp/plain' is a file" "$tmp/nodir.err" || fail "folder message: $(cat "$tmp/nodir.err")"
 "$veil" frobnicate 2>/dev/null; [ $? -eq 2 ] || fail "unknown command must exit 2"
 # the quality ladder and the light-space spacing: bad values refused, good ones in the plan (no GPU)
 for bad in "--quality best" "--od-spacing 0" "--od-spacing 1,2,3" "--od-spacing nan" "--od-spacing 0.5,x"; do

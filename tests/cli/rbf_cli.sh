@@ -27,10 +27,13 @@ generate)
     "$veil" rbf generate -o e.bin --count 1000 --seed 43 --bounds -1,-0.5,-1,1,0.5,1 --radius 0.05,0.2 \
         --amplitude 0.5,2 >/dev/null 2>&1 || fail "seed 43"
     cmp -s a.bin e.bin && fail "seeds 42 and 43 give the same file"
-    gen -o no_such_dir/x.bin >/dev/null 2>err.txt; rc=$?
-    [ $rc = 1 ] || fail "missing folder: exit $rc, expected 1"
-    grep -q "no_such_dir/x.bin" err.txt || fail "missing folder message: $(cat err.txt)"
-    ls no_such_dir >/dev/null 2>&1 && fail "missing folder was created"
+    # a missing folder is made (issue 22); one under a file is a usage error, nothing made
+    gen -o no_such_dir/x.bin >/dev/null 2>err.txt || fail "a missing folder: exit $?: $(cat err.txt)"
+    cmp -s a.bin no_such_dir/x.bin || fail "no_such_dir/x.bin is not a.bin"
+    touch plain
+    gen -o plain/dir/x.bin >/dev/null 2>err.txt; rc=$?
+    [ $rc = 2 ] || fail "a folder under a file: exit $rc, expected 2"
+    grep -q "plain/dir/x.bin': its folder 'plain' is a file" err.txt || fail "folder message: $(cat err.txt)"
     ;;
 render)
     if ! "$veil" gpuinfo >/dev/null 2>&1; then

@@ -84,9 +84,10 @@ else
   [ ! -e "$tmp/t.mp4" ] || fail "a movie file without ffmpeg"
 fi
 ls "$tmp" | grep -q 'veil-frames\|veil-staged' && fail "the movie's scratch files were left behind"
-# a review output into a folder that does not exist is refused before any frame
-"$veil" turntable "$scene" -o "$tmp/none.####.exr" --frames 2 --movie "$tmp/no/such/dir/t.mp4" 2> "$tmp/dir.err" > /dev/null
-[ $? -eq 1 ] && grep -q "no/such/dir" "$tmp/dir.err" || fail "a movie into a missing folder: $(cat "$tmp/dir.err")"
+# a review output whose folder is a file is refused before any frame (a missing folder is made)
+touch "$tmp/plain"
+"$veil" turntable "$scene" -o "$tmp/none.####.exr" --frames 2 --movie "$tmp/plain/dir/t.mp4" 2> "$tmp/dir.err" > /dev/null
+[ $? -eq 2 ] && grep -q "its folder '$tmp/plain' is a file" "$tmp/dir.err" || fail "a movie under a file: $(cat "$tmp/dir.err")"
 ls "$tmp" | grep -q '^none\.' && fail "frames were rendered before the movie's folder was checked"
 # a shard alone cannot make the movie of the whole range
 rm "$tmp/two/t.1007.exr"
