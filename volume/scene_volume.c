@@ -368,6 +368,12 @@ static veil_result choose_grid(const veil_scene* s, veil_scene_volume* v, const 
                      rep == VEIL_REPRESENTATION_SPARSE ? "medium.representation" : "over the dense cap of 2^27 voxels");
             return VEIL_OK;
         }
+        /* asked for, a grid the sparse tables cannot hold is an error (auto resamples it, and says why) */
+        if (rep == VEIL_REPRESENTATION_SPARSE) {
+            const char* why = strncmp(v->resolution, "resampled: ", 11) ? v->resolution : v->resolution + 11;
+            return veil_fail(err, VEIL_ERR_INVALID, "medium.representation: \"sparse\" is not possible here: %s; "
+                             "\"auto\" resamples it, or set medium.max_resolution", why[0] ? why : "no native grid");
+        }
         if (!v->resolution[0]) snprintf(v->resolution, sizeof v->resolution, "%s", dense_note);
     }
     int res = s->medium.max_resolution;
