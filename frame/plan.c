@@ -105,6 +105,11 @@ static veil_result plan_open(veil_frame* f, const veil_scene* s, const veil_rend
     p->vdb_voxels = v->vdb_voxels;
     p->resolution = p->volume_needed ? v->resolution : NULL;
     p->emission_possible = p->grid && v->emission_count > 0 && s->multiple.emission_lights > 0;
+    /* a sparse volume's work as a render estimates it before the gather; a refusal is part of the plan */
+    veil_error why = {0};
+    r = veil_frame_sparse_estimate(p, v, &p->sparse_work, &why);
+    if (r == VEIL_ERR_LIMIT) snprintf(p->sparse_refusal, sizeof p->sparse_refusal, "%s", why.msg);
+    else if (r != VEIL_OK) return veil_fail(err, r, "%s", why.msg);
     return VEIL_OK;
 }
 
@@ -150,6 +155,8 @@ veil_result veil_plan_reports(const veil_scene* s, const veil_render_opts* opts,
     veil_frame f;
     veil_scene_volume v;
     veil_result r = plan_open(&f, s, opts, &v, err);
+    if (r == VEIL_OK && f.plan.sparse_refusal[0]) /* the render refuses it before any stage runs */
+        r = veil_fail(err, VEIL_ERR_LIMIT, "%s", f.plan.sparse_refusal);
     if (r == VEIL_OK) {
         char why[VEIL_STAGE_WHY_MAX];
         walk(&f, first, later, why, sizeof why, 2, NULL);

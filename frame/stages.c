@@ -154,6 +154,59 @@ void veil_frame_plan_volume(veil_frame_plan* p, const veil_grid* g, int sparse, 
         .diffusion_iterations = m->diffusion_iterations};
 }
 
+veil_result veil_frame_sparse_estimate(const veil_frame_plan* p, const veil_scene_volume* v, veil_sparse_work* w,
+                                       veil_error* err)
+{
+    memset(w, 0, sizeof *w);
+    if (!v->has_volume || !v->sparse) return VEIL_OK;
+    veil_sparse_census c;
+    veil_result r = veil_sparse_census_of(v, &c, err);
+    if (r == VEIL_OK) r = veil_sparse_census_check(&c, err);
+    if (r != VEIL_OK) {
+        veil_sparse_census_free(&c);
+        return r;
+    }
+    /* the lights as the plan will hold them once the volume is made (inject's settle) */
+    veil_frame_plan* q = malloc(sizeof *q);
+    if (!q) {
+        veil_sparse_census_free(&c);
+        return veil_fail(err, VEIL_ERR_OOM, "out of memory estimating the sparse volume's work");
+    }
+    *q = *p;
+    veil_frame_plan_volume(q, &v->grid, 1, NULL, 0);
+    int lights = q->light_count;
+    veil_index_light ol[VEIL_MAX_LIGHTS];
+    memcpy(ol, q->index_lights, (size_t)lights * sizeof *ol);
+    if (v->emission_count > 0 && v->emission_lights > 0) {
+        /* the emission's lights come from the gather (if it glows at all): points at the grid's middle stand
+         * for them */
+        int room = VEIL_MAX_LIGHTS - lights, e = v->emission_lights < room ? v->emission_lights : room;
+        for (int i = 0; i < e; ++i, ++lights) {
+            memset(&ol[lights], 0, sizeof ol[lights]);
+            ol[lights].type = VEIL_LIGHT_POINT;
+            for (int a = 0; a < 3; ++a) {
+                ol[lights].v[a] = 0.5f * (float)v->grid.dims[a] - 0.5f; /* voxel i's centre at i */
+                ol[lights].c[a] = v->grid.dims[a] / 2;
+            }
+        }
+    }
+    memcpy(w->dims, v->grid.dims, sizeof w->dims);
+    w->bricks = (double)c.count;
+    w->lights = lights;
+    for (int l = 0; l < lights; ++l) {
+        w->passes += (double)veil_opv_sparse_passes(c.coords, c.count, &ol[l]);
+        w->od_units += veil_sparse_od_units(&c, &ol[l]) / lights;
+    }
+    w->od_rays = (double)c.count * (VEIL_SPARSE_APRON * VEIL_SPARSE_APRON * VEIL_SPARSE_APRON) * lights;
+    if (lights > 0 && q->volumetric.kind == VEIL_FIELD_ESCAPE) { /* volumetric_decide: the fluence is skipped */
+        w->escape_rays = veil_volumetric_sparse_escape_rays((double)c.count);
+        w->escape_units = veil_sparse_escape_units(&c);
+    }
+    free(q);
+    veil_sparse_census_free(&c);
+    return veil_sparse_work_check(w, err);
+}
+
 #if defined(__GNUC__)
 __attribute__((format(printf, 3, 4)))
 #endif
@@ -222,7 +275,20 @@ static veil_stage_status inject_decide(const veil_frame_plan* p, int kept, char*
         say(w, n, "the sources hold no density (no particle, no active voxel)");
         return VEIL_STAGE_SKIPPED;
     }
-    if (p->grid && p->resolution) /* explaining: what the files hold */
+    if (p->grid && p->resolution && p->sparse) { /* explaining a sparse volume: and its work, estimated */
+        const veil_sparse_work* k = &p->sparse_work;
+        char work[VEIL_ERROR_MAX + 64];
+        if (p->sparse_refusal[0])
+            snprintf(work, sizeof work, "a render refuses it: %s", p->sparse_refusal);
+        else
+            snprintf(work, sizeof work, "work ~%.3g s of a CPU driver's time (at most %g): %.0f bricks, %.0f passes for %d "
+                     "light%s, %.3g texel rays of %.0f steps, %.3g escape rays of %.0f steps", k->seconds,
+                     VEIL_SPARSE_MAX_SECONDS, k->bricks, k->passes, k->lights, k->lights == 1 ? "" : "s", k->od_rays,
+                     k->od_units, k->escape_rays, k->escape_units);
+        say(w, n, "key %016llx: %zu particles, %zu VDB voxels -> grid %dx%dx%d, voxel %.4g m\n           %s\n           %s",
+            (unsigned long long)inject_key(p), p->particles, p->vdb_voxels, p->grid->dims[0], p->grid->dims[1],
+            p->grid->dims[2], p->grid->voxel, p->resolution, work);
+    } else if (p->grid && p->resolution) /* explaining: what the files hold */
         say(w, n, "key %016llx: %zu particles, %zu VDB voxels -> grid %dx%dx%d, voxel %.4g m\n           %s",
             (unsigned long long)inject_key(p), p->particles, p->vdb_voxels, p->grid->dims[0], p->grid->dims[1],
             p->grid->dims[2], p->grid->voxel, p->resolution);
@@ -246,8 +312,11 @@ static veil_result inject_build(veil_frame* f, veil_stage_report* rep, veil_erro
     veil_scene_volume v;
     veil_result res = veil_scene_volume_open(p->scene, &v, err);
     if (res != VEIL_OK) return res;
+    /* a sparse volume's work, before the gather (and the GPU's work) starts */
+    veil_sparse_work work;
+    res = veil_frame_sparse_estimate(p, &v, &work, err);
     veil_ev_report er = {0};
-    res = veil_ev_build_scene(r->ev, &v, (int)p->scene->light_count, p->budget, &er, err);
+    if (res == VEIL_OK) res = veil_ev_build_scene(r->ev, &v, (int)p->scene->light_count, p->budget, &er, err);
     if (res == VEIL_OK) {
         r->has[VEIL_STAGE_INJECT] = 1, r->kept[VEIL_STAGE_INJECT] = rep->key;
         r->particles = er.particles;

@@ -32,6 +32,7 @@
 #include "../propagate/opv_set.h"
 #include "../render/image_set.h"
 #include "../scene/scene.h"
+#include "../volume/sparse.h"
 #include "../volume/volume.h"
 #include "../volumetric/volumetric.h"
 #include "stage.h"
@@ -110,6 +111,10 @@ typedef struct veil_frame_plan {
     uint64_t sun_keys[VEIL_MAX_SUNS];
     int sun_count;
     veil_volumetric_desc volumetric; /* its kind (VEIL_FIELD_NONE: no field wanted) and grid settings */
+    /* explaining a sparse volume: the frame's work as estimated before the gather (volume/sparse.h), and
+     * why a render refuses it ("" when it does not) */
+    veil_sparse_work sparse_work;
+    char sparse_refusal[VEIL_ERROR_MAX];
 } veil_frame_plan;
 
 /* The plan's first step: the options resolved for scene s. */
@@ -121,6 +126,18 @@ void veil_frame_plan_begin(veil_frame_plan* p, const veil_scene* s, const veil_r
  * lights) while there is room, and the propagation's parameters. */
 void veil_frame_plan_volume(veil_frame_plan* p, const veil_grid* g, int sparse, const veil_light* emission,
                             int n_emission);
+
+/* The work of a frame over the sparse volume v (nothing when v is not
+ * sparse) under plan p, estimated before the gather: the census of its
+ * bricks (refused over VEIL_SPARSE_MAX_BRICKS, a tile counted by its box,
+ * never expanded), the lights as planned on v's grid (and the emission's,
+ * while there is room, as points at its middle: they are made by the
+ * gather), their passes as propagate/opv_set.c orders them, and the
+ * escape field's rays when the octaves ask for it. VEIL_ERR_LIMIT with the
+ * numbers over VEIL_SPARSE_MAX_SECONDS. Needs no GPU. */
+struct veil_scene_volume;
+veil_result veil_frame_sparse_estimate(const veil_frame_plan* p, const struct veil_scene_volume* v,
+                                       veil_sparse_work* w, veil_error* err);
 
 /* The GPU objects that hold the stages' results between frames (owned by
  * the renderer; the rows only use them) and the keys they hold. */

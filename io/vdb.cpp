@@ -589,6 +589,49 @@ veil_result veil_vdb_each_voxel(const veil_vdb* v, veil_vdb_voxel_fn fn, void* u
     });
 }
 
+veil_result veil_vdb_each_box(const veil_vdb* v, veil_vdb_box_fn fn, void* user, veil_error* err)
+{
+    if (!v || !fn) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_each_box: missing argument");
+    return guarded(err, v->path.c_str(), [&] {
+        const FloatGrid::TreeType& tree = v->grid->tree();
+        for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
+            CoordBBox box;
+            uint64_t n = 0;
+            for (auto it = leaf->cbeginValueOn(); it; ++it)
+                if (*it != 0.0f) box.expand(it.getCoord()), ++n;
+            if (!n) continue;
+            const int lo[3] = {box.min()[0], box.min()[1], box.min()[2]}, hi[3] = {box.max()[0], box.max()[1], box.max()[2]};
+            if (!fn(user, lo, hi, n, 0)) return;
+        }
+        // the tiles: every level above the leaves (their values are the tiles')
+        FloatGrid::ValueOnCIter it = v->grid->cbeginValueOn();
+        it.setMaxDepth(FloatGrid::ValueOnCIter::LEAF_DEPTH - 1);
+        for (; it; ++it) {
+            if (*it == 0.0f) continue;
+            CoordBBox box;
+            it.getBoundingBox(box);
+            const int lo[3] = {box.min()[0], box.min()[1], box.min()[2]}, hi[3] = {box.max()[0], box.max()[1], box.max()[2]};
+            if (!fn(user, lo, hi, box.volume(), 1)) return;
+        }
+    });
+}
+
+static int census_box(void* user, const int lo[3], const int hi[3], uint64_t voxels, int tile)
+{
+    (void)lo, (void)hi;
+    veil_vdb_census* c = static_cast<veil_vdb_census*>(user);
+    if (tile) ++c->tiles, c->tile_voxels += (double)voxels;
+    else ++c->leaves, c->leaf_voxels += voxels;
+    return 1;
+}
+
+veil_result veil_vdb_census_of(const veil_vdb* v, veil_vdb_census* out, veil_error* err)
+{
+    if (!out) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_census_of: missing argument");
+    *out = veil_vdb_census{};
+    return veil_vdb_each_box(v, census_box, out, err);
+}
+
 veil_result veil_vdb_file_info(const char* path, veil_vdb_grid_info** grids, size_t* count, veil_error* err)
 {
     if (!path || !grids || !count) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_file_info: missing argument");

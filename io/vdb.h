@@ -99,6 +99,27 @@ veil_result veil_vdb_dense(const veil_vdb* v, const int lo[3], const int hi[3], 
 typedef void (*veil_vdb_voxel_fn)(void* user, const int ijk[3], float value);
 veil_result veil_vdb_each_voxel(const veil_vdb* v, veil_vdb_voxel_fn fn, void* user, veil_error* err);
 
+/* The grid's non-zero active values as its tree holds them, without
+ * expanding a tile (what veil_vdb_each_voxel would visit, counted first):
+ * fn(user, lo, hi, voxels, tile) for each leaf node with an active voxel
+ * whose value is not 0 (lo, hi: the inclusive index box of those voxels,
+ * voxels: how many), then each active tile whose value is not 0 (its box,
+ * voxels: its volume: 8^3, 128^3 or 4096^3 in OpenVDB's default tree).
+ * fn returns 0 to stop the walk (the call still returns VEIL_OK). Cost: a
+ * look at each leaf's active voxels and one visit per tile, never one per
+ * voxel of a tile. */
+typedef int (*veil_vdb_box_fn)(void* user, const int lo[3], const int hi[3], uint64_t voxels, int tile);
+veil_result veil_vdb_each_box(const veil_vdb* v, veil_vdb_box_fn fn, void* user, veil_error* err);
+
+/* The same, summed. */
+typedef struct veil_vdb_census {
+    uint64_t leaves;      /* leaf nodes (8^3 voxels) with a non-zero active voxel */
+    uint64_t leaf_voxels; /* their non-zero active voxels */
+    uint64_t tiles;       /* active tiles of a non-zero value, at any level of the tree */
+    double tile_voxels;   /* the voxels they stand for (a root may hold any number of 4096^3 tiles) */
+} veil_vdb_census;
+veil_result veil_vdb_census_of(const veil_vdb* v, veil_vdb_census* out, veil_error* err);
+
 /* One grid of a file, as `veil info` shows it. */
 typedef struct veil_vdb_grid_info {
     char* name;            /* owned */

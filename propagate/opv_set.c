@@ -126,6 +126,42 @@ static long long level_of(const veil_index_light* l, const int32_t* b, int sun_s
     return v;
 }
 
+/* What level_of needs of light l: the signs of a sun's direction, a point light's brick. */
+static void level_setup(const veil_index_light* l, int sign[3], int cb[3])
+{
+    for (int a = 0; a < 3; ++a) {
+        /* the light in the sparse index space (opv.h's has voxel i's centre at i, this one at i + 0.5) */
+        float light = l->v[a] + (l->type == VEIL_LIGHT_DIRECTIONAL ? 0.0f : 0.5f);
+        sign[a] = l->v[a] > 0.0f ? 1 : l->v[a] < 0.0f ? -1 : 0;
+        double cell = floor(((double)light - 0.5) / VEIL_BRICK);
+        cb[a] = cell < -1e9 ? -1000000000 : cell > 1e9 ? 1000000000 : (int)cell;
+    }
+}
+
+size_t veil_opv_sparse_passes(const int32_t* bricks, size_t n, const veil_index_light* l)
+{
+    if (!n) return 0;
+    int sign[3], cb[3];
+    level_setup(l, sign, cb);
+    long long lo = 0, hi = 0;
+    for (size_t i = 0; i < n; ++i) {
+        long long v = level_of(l, bricks + 4 * i, sign, cb);
+        if (i == 0 || v < lo) lo = v;
+        if (i == 0 || v > hi) hi = v;
+    }
+    /* the levels span at most the bricks' extent on the three axes (a few thousand): a byte each */
+    size_t range = (size_t)(hi - lo) + 1, passes = 0;
+    unsigned char* seen = calloc(range, 1);
+    if (!seen) return range < n ? range : n; /* at most either */
+    for (size_t i = 0; i < n; ++i) {
+        size_t k = (size_t)(level_of(l, bricks + 4 * i, sign, cb) - lo);
+        passes += !seen[k];
+        seen[k] = 1;
+    }
+    free(seen);
+    return passes;
+}
+
 /* Texture t over a sparse volume: for each light, passes of
  * propagate/shaders/propagate_sparse.comp over the kept bricks, level by
  * level (each pass reads only bricks of earlier passes). *passes: the most
@@ -152,12 +188,8 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
         memset(&blk, 0, sizeof blk);
         float* light = blk.light;
         int sign[3], cb[3];
-        for (int a = 0; a < 3; ++a) {
-            light[a] = ol[c].v[a] + (ol[c].type == VEIL_LIGHT_DIRECTIONAL ? 0.0f : 0.5f);
-            sign[a] = ol[c].v[a] > 0.0f ? 1 : ol[c].v[a] < 0.0f ? -1 : 0;
-            double cell = floor(((double)light[a] - 0.5) / VEIL_BRICK);
-            cb[a] = cell < -1e9 ? -1000000000 : cell > 1e9 ? 1000000000 : (int)cell;
-        }
+        for (int a = 0; a < 3; ++a) light[a] = ol[c].v[a] + (ol[c].type == VEIL_LIGHT_DIRECTIONAL ? 0.0f : 0.5f);
+        level_setup(&ol[c], sign, cb);
         light[3] = (float)ol[c].type;
         blk.pass[0] = c;
         /* counting sort of the slots by level */

@@ -83,6 +83,13 @@ int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* li
                        const veil_opv_params* params, int max_axis, veil_index_light* ol, veil_opv_sun* want,
                        uint64_t* want_key);
 
+/* The passes veil_opv_set_update makes for light l over a sparse volume
+ * whose kept bricks are `bricks` (n of them, 4 ints each: x, y, z, 0): its
+ * distinct levels in the order of the passes (each brick's path to the
+ * light leaves it towards bricks of earlier passes only). Needs no GL: the
+ * frame's work estimate counts them before the volume is made. */
+size_t veil_opv_sparse_passes(const int32_t* bricks, size_t n, const veil_index_light* l);
+
 /* The light-space grids of the last update (*count of them). */
 const veil_opv_sun* veil_opv_set_suns(const veil_opv_set* s, int* count);
 

@@ -127,6 +127,11 @@ static veil_result texture3d(const int dims[3], const char* label, GLuint* tex, 
     return veil_gl_check(label, err);
 }
 
+double veil_volumetric_sparse_escape_rays(double bricks)
+{
+    return bricks * (VEIL_SPARSE_ESCAPE * VEIL_SPARSE_ESCAPE * VEIL_SPARSE_ESCAPE) * VEIL_ESCAPE_DIRECTIONS;
+}
+
 /* The escape field of a sparse volume: VEIL_SPARSE_ESCAPE^3 points a kept
  * brick, in an atlas laid out like the density's (volumetric/shaders/escape.comp
  * with VEIL_SPARSE). */

@@ -88,6 +88,13 @@ veil_result veil_volumetric_update(veil_volumetric* v, const veil_volumetric_des
  * escape field is laid per kept brick instead. */
 int veil_volumetric_grid(const veil_volumetric_desc* d, float lo[3], float* h, int dims[3]);
 
+/* The rays the escape field casts over a sparse volume of `bricks` kept
+ * bricks: VEIL_SPARSE_ESCAPE^3 points a brick, each marched along the 6
+ * axes and the 8 diagonals (shaders/escape.comp); for the frame's work
+ * estimate (volume/sparse.h). */
+#define VEIL_ESCAPE_DIRECTIONS 14
+double veil_volumetric_sparse_escape_rays(double bricks);
+
 /* The red-black sweeps the fluence on a grid of dims takes (0 for the escape field). */
 int veil_volumetric_sweeps(const veil_volumetric_desc* d, const int dims[3]);
 

@@ -37,8 +37,9 @@ void main()
     vec2 s = box_hit(q, d, vec3(0.5), sp.dims.xyz - 0.5, 0.0, len);
     float D = 0.0;
     if (s.x < s.y) {
-        // through its own brick
-        float t = min(sp_region_exit(q, d, b, 1), s.y);
+        // through its own brick (a texel on a face it leaves along a component too small to move it off
+        // in float stays in its brick: to the next face then, or it would read its own unmade depth)
+        float t = min(sp_brick(q + d * 1e-3) == b ? sp_region_exit_ahead(q, d, b, 1) : sp_region_exit(q, d, b, 1), s.y);
         D = sp_integral(q, d, 0.0, t, VEIL_SPARSE_OD_STEP) * sp.origin.w;
         // past the bricks without density, to the first kept one: its optical depth where the path enters it
         while (t < s.y) {
@@ -50,7 +51,7 @@ void main()
                 D += texture(u_depth, sp_atlas_uvw(slot, nb, q + d * t))[od.pass.x];
                 break;
             }
-            t += max(sp_region_exit(q + d * t, d, nb, region), ahead);
+            t += max(sp_region_exit_ahead(q + d * t, d, nb, region), ahead);
         }
     }
     vec4 all = imageLoad(u_out, corner + j);

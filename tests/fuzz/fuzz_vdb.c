@@ -1,12 +1,48 @@
 /* libFuzzer target: the OpenVDB reader (io/vdb.h): the file's grids, then
- * its density grid opened, as `veil info` and `veil render` read them.
+ * its density grid opened, as `veil info` and `veil render` read them, its
+ * leaves and tiles counted (veil_vdb_census_of), and, in a scene that asks
+ * for it sparse, the census of its bricks and the frame's work as a render
+ * estimates them before the gather (frame/stages.h; CPU only, no GL).
  * fuzz_nanovdb.c is this target for .nvdb files (FUZZ_VDB_FILE). */
 #include "fuzz_common.h"
+#include "frame/stages.h"
+#include "io/scene.h"
 #include "io/vdb.h"
+#include "volume/scene_volume.h"
 
 #ifndef FUZZ_VDB_FILE
 #define FUZZ_VDB_FILE "f.vdb" /* the reader is chosen by the name's suffix */
 #endif
+
+/* The file as a sparse medium: the census and the work estimate, refused or
+ * not; any failure must say why. */
+static void sparse_estimate(const char* path)
+{
+    char json[512];
+    snprintf(json, sizeof json,
+             "{\"camera\": {\"position\": [0, 0, -5], \"look_at\": [0, 0, 0], \"width\": 8, \"height\": 6},"
+             " \"medium\": {\"sigma_s\": [1, 1, 1], \"representation\": \"sparse\","
+             "  \"sources\": [{\"type\": \"vdb\", \"file\": \"%s\", \"level_set\": \"to_fog\"}]},"
+             " \"lights\": [{\"type\": \"directional\", \"direction\": [-1, -2, -3], \"irradiance\": [1, 1, 1]},"
+             "  {\"type\": \"point\", \"position\": [0, 1, 0], \"intensity\": [1, 1, 1]}]}",
+             path);
+    veil_scene s;
+    veil_error err = {0};
+    if (veil_scene_parse("fuzz.json", json, strlen(json), &s, &err) != VEIL_OK) abort(); /* the scene is ours */
+    veil_scene_volume v;
+    veil_error e2 = {0};
+    if (veil_scene_volume_open(&s, &v, &e2) == VEIL_OK) {
+        veil_frame_plan p;
+        veil_frame_plan_begin(&p, &s, NULL, 0);
+        veil_sparse_work w;
+        veil_error e3 = {0};
+        if (veil_frame_sparse_estimate(&p, &v, &w, &e3) != VEIL_OK && !e3.msg[0]) abort();
+        veil_scene_volume_close(&v);
+    } else if (!e2.msg[0]) {
+        abort();
+    }
+    veil_scene_free(&s);
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 {
@@ -19,7 +55,14 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     veil_vdb* v = NULL;
     char chosen[64];
     veil_error e2 = {0};
-    if (veil_vdb_open(path, NULL, 1, &v, chosen, sizeof chosen, &e2) == VEIL_OK) veil_vdb_close(v);
-    else if (!e2.msg[0]) abort();
+    if (veil_vdb_open(path, NULL, 1, &v, chosen, sizeof chosen, &e2) == VEIL_OK) {
+        veil_vdb_census c;
+        veil_error e3 = {0};
+        if (veil_vdb_census_of(v, &c, &e3) != VEIL_OK && !e3.msg[0]) abort();
+        veil_vdb_close(v);
+        sparse_estimate(path);
+    } else if (!e2.msg[0]) {
+        abort();
+    }
     return 0;
 }

@@ -32,6 +32,7 @@
 #include "volume/ev.h"
 #include "volume/scene_volume.h"
 #include "volume/sparse.h"
+#include "volume/vdb_volume.h"
 
 static const char* g_dir;
 
@@ -312,6 +313,19 @@ static void test_depth(void)
                         }
                     }
         }
+        /* the passes the frame's work estimate counts (veil_opv_sparse_passes) are the passes made: the
+         * lights as the update makes them (no light-space grids over a sparse volume) */
+        veil_index_light ol[VEIL_MAX_LIGHTS];
+        veil_opv_sun want[VEIL_MAX_SUNS];
+        uint64_t want_key[VEIL_MAX_SUNS];
+        veil_opv_plan_suns(&v.grid, 1, lights, 2, &params, 0, ol, want, want_key);
+        size_t passes = 0;
+        for (int l = 0; l < 2; ++l) {
+            size_t p = veil_opv_sparse_passes(esp->bricks, esp->slots, &ol[l]);
+            passes = p > passes ? p : passes;
+        }
+        CHECK(passes > 1 && passes == (size_t)orep.iterations, "the estimate counts %zu passes, the update made %d",
+              passes, orep.iterations);
         CHECK(checked > 10000 && columns >= 18 && bad == 0,
               "%ld of %ld optical depths off the exact integral (worst %.3g of the bound; %ld on the point light's column)",
               bad, checked, worst, columns);
@@ -519,6 +533,129 @@ static void test_emission(void)
     veil_gl_destroy(gl);
 }
 
+/* Whether brick b is among the census's (its coordinates sorted by sort_coords). */
+static int cmp_brick(const void* a, const void* b)
+{
+    const int32_t *x = a, *y = b;
+    for (int k = 2; k >= 0; --k)
+        if (x[k] != y[k]) return x[k] < y[k] ? -1 : 1;
+    return 0;
+}
+
+/* The census (volume/sparse.h) of v against the volume veil_sparse_build
+ * makes of it: every brick the gather made (one whose own 8^3 voxels hold
+ * a value not 0: the dilation's own are 0 there) is counted, and the
+ * census counts at most the bricks its boxes cover. Returns the built count. */
+static size_t census_covers(const char* what, const veil_scene_volume* v, veil_sparse_census* c)
+{
+    veil_error err = {0};
+    veil_sparse sp;
+    CHECK(veil_sparse_census_of(v, c, &err) == VEIL_OK && !c->over, "%s: census: %s", what, err.msg);
+    CHECK(veil_sparse_build(v, 2048, &sp, &err) == VEIL_OK, "%s: %s", what, err.msg);
+    if (!c->coords || !sp.texels) return 0;
+    qsort(c->coords, c->count, 4 * sizeof *c->coords, cmp_brick);
+    size_t made = 0, missing = 0;
+    int t[3];
+    veil_sparse_atlas_texels(&sp, t);
+    for (size_t slot = 0; slot < sp.count; ++slot) {
+        int corner[3] = {(int)(slot % (size_t)sp.atlas[0]) * VEIL_SPARSE_APRON,
+                         (int)(slot / (size_t)sp.atlas[0] % (size_t)sp.atlas[1]) * VEIL_SPARSE_APRON,
+                         (int)(slot / ((size_t)sp.atlas[0] * (size_t)sp.atlas[1])) * VEIL_SPARSE_APRON};
+        int own = 0; /* density or emission in its own 8^3 voxels */
+        for (int z = 0; z < VEIL_BRICK && !own; ++z)
+            for (int y = 0; y < VEIL_BRICK; ++y)
+                for (int x = 0; x < VEIL_BRICK; ++x) {
+                    size_t at = (size_t)(corner[0] + x) +
+                                (size_t)t[0] * ((size_t)(corner[1] + y) + (size_t)t[1] * (size_t)(corner[2] + z));
+                    own |= sp.texels[at] != 0.0f;
+                    for (int k = 0; k < 3 && sp.emission_texels; ++k) own |= sp.emission_texels[4 * at + (size_t)k] != 0.0f;
+                }
+        made += own;
+        int32_t key[4] = {sp.coords[4 * slot], sp.coords[4 * slot + 1], sp.coords[4 * slot + 2], 0};
+        missing += own && !bsearch(key, c->coords, c->count, 4 * sizeof *c->coords, cmp_brick);
+    }
+    CHECK(made > 0 && missing == 0, "%s: %zu of the %zu bricks the gather made are not in the census", what, missing,
+          made);
+    CHECK((double)c->count == c->bricks, "%s: census of %zu distinct bricks reports %.0f", what, c->count, c->bricks);
+    printf("%s: census %zu bricks (%llu leaves of %llu voxels, %llu tiles of %.0f voxels); the gather made %zu, "
+           "kept %zu\n", what, c->count, (unsigned long long)c->leaves, (unsigned long long)c->leaf_voxels,
+           (unsigned long long)c->tiles, c->tile_voxels, made, sp.count);
+    size_t kept = sp.count;
+    veil_sparse_free(&sp);
+    return kept;
+}
+
+/* The census before the gather (volume/sparse.h): the puffs' leaves, the
+ * slab's emission grid, and (tiles_dir: make_sparse_vdbs's files) a 128^3
+ * tile counted by its box, equal to what the gather makes of it, and a
+ * 4096^3 one refused from its count. */
+static void test_census(void)
+{
+    veil_scene s;
+    veil_scene_volume v;
+    veil_sparse_census c;
+    if (open_volume("sparse_puffs.vdb", "auto", &s, &v) == VEIL_OK) {
+        census_covers("puffs", &v, &c);
+        CHECK(c.tiles == 0 && c.leaf_voxels == v.vdb_voxels, "puffs: %llu tiles, %llu of %zu voxels",
+              (unsigned long long)c.tiles, (unsigned long long)c.leaf_voxels, v.vdb_voxels);
+        veil_sparse_census_free(&c);
+        veil_scene_volume_close(&v);
+        veil_scene_free(&s);
+    } else {
+        CHECK(0, "opening sparse_puffs.vdb");
+    }
+    if (slab_scene("emission", "sparse", 0, &s) == VEIL_OK) {
+        veil_error err = {0};
+        CHECK(veil_scene_volume_open(&s, &v, &err) == VEIL_OK, "%s", err.msg);
+        if (v.sparse) census_covers("emissive slab", &v, &c);
+        CHECK(v.sparse && c.leaves > 0, "the slab is not sparse, or its census is empty");
+        veil_sparse_census_free(&c);
+        veil_scene_volume_close(&v);
+        veil_scene_free(&s);
+    }
+    /* a 128^3 tile: counted by its box, equal to the gather's; a 4096^3 one: over the cap, never expanded */
+    if (open_volume("sparse/tile_128.vdb", "sparse", &s, &v) == VEIL_OK) {
+        size_t kept = census_covers("128^3 tile", &v, &c);
+        int lo[3], hi[3], off[3];
+        size_t active = 0;
+        veil_vdb_index_bbox(v.vdbs[0], lo, hi, &active);
+        double edge, origin[3], want = 1.0;
+        int al;
+        veil_vdb_lattice(v.vdbs[0], &edge, origin, &al);
+        for (int a = 0; a < 3; ++a) { /* VDB index i at grid voxel i + off (the grid's voxel centres on the lattice) */
+            off[a] = (int)lround((origin[a] - v.grid.origin[a]) / v.grid.voxel - 0.5);
+            want *= (double)((hi[a] + off[a]) / VEIL_BRICK - (lo[a] + off[a]) / VEIL_BRICK + 1);
+        }
+        CHECK(c.tiles == 1 && c.leaves == 0 && c.tile_voxels == 128.0 * 128 * 128 && (double)c.count == want &&
+                  kept == c.count,
+              "128^3 tile: %llu tiles of %.0f voxels, %zu bricks counted, %.0f covered, %zu kept",
+              (unsigned long long)c.tiles, c.tile_voxels, c.count, want, kept);
+        veil_sparse_census_free(&c);
+        veil_scene_volume_close(&v);
+        veil_scene_free(&s);
+    } else {
+        CHECK(0, "opening sparse/tile_128.vdb");
+    }
+    if (open_volume("sparse/tile_4096.vdb", "auto", &s, &v) == VEIL_OK) {
+        veil_error err = {0};
+        CHECK(veil_sparse_census_of(&v, &c, &err) == VEIL_OK, "%s", err.msg);
+        CHECK(c.over && c.bricks >= 512.0 * 512 * 512 && !c.coords && c.tiles == 1,
+              "4096^3 tile: over %d, %.0f bricks, %llu tiles", c.over, c.bricks, (unsigned long long)c.tiles);
+        CHECK(veil_sparse_census_check(&c, &err) == VEIL_ERR_LIMIT && strstr(err.msg, "1 active tiles") &&
+                  strstr(err.msg, "VEIL_SPARSE_MAX_BRICKS"),
+              "4096^3 tile refused: %s", err.msg);
+        veil_sparse sp;
+        veil_error e2 = {0};
+        CHECK(veil_sparse_build(&v, 2048, &sp, &e2) == VEIL_ERR_LIMIT && strstr(e2.msg, "1 active tiles"),
+              "4096^3 tile built: %s", e2.msg);
+        veil_sparse_census_free(&c);
+        veil_scene_volume_close(&v);
+        veil_scene_free(&s);
+    } else {
+        CHECK(0, "opening sparse/tile_4096.vdb");
+    }
+}
+
 int main(int argc, char** argv)
 {
     if (argc != 3) {
@@ -529,7 +666,8 @@ int main(int argc, char** argv)
     static const struct {
         const char* name;
         void (*fn)(void);
-    } cases[] = {{"structure", test_structure}, {"depth", test_depth}, {"render", test_render}, {"emission", test_emission}};
+    } cases[] = {{"structure", test_structure}, {"depth", test_depth}, {"render", test_render}, {"emission", test_emission},
+                   {"census", test_census}};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i)
         if (strcmp(argv[2], cases[i].name) == 0) {
             cases[i].fn();
