@@ -18,6 +18,13 @@ const range VEIL__R_COORD = {-VEIL_MAX_COORD, VEIL_MAX_COORD, false, false, fals
 const range VEIL__R_LIGHT = {0, VEIL_MAX_LIGHT, false, false, false, "a number in [0, 1e20] (scene/limits.h)"};
 const range VEIL__R_SHARPNESS = {VEIL_MIN_SHARPNESS, DBL_MAX, false, false, false,
                                  "a number >= 1e-29 (its cut-off radius within 1e15 m: scene/limits.h)"};
+const range VEIL__R_SIGMA = {0, VEIL_MAX_SIGMA, false, false, false, "a number in [0, 1e10] (m^-1: scene/limits.h)"};
+const range VEIL__R_DENSITY = {0, VEIL_MAX_DENSITY, false, false, false, "a number in [0, 1e10] (scene/limits.h)"};
+const range VEIL__R_FALLOFF = {0, VEIL_MAX_FALLOFF, false, false, false, "a number in [0, 1e20] (m^-1: scene/limits.h)"};
+const range VEIL__R_EMISSION = {0, VEIL_MAX_EMISSION, false, false, false, "a number in [0, 1e21] (scene/limits.h)"};
+const range VEIL__R_KELVIN = {-VEIL_MAX_KELVIN, VEIL_MAX_KELVIN, false, false, false,
+                              "a number in [-1e5, 1e5] (K: scene/limits.h)"};
+const range VEIL__R_BACKGROUND = {0, VEIL_MAX_BACKGROUND, false, false, false, "a number in [0, 1e20] (scene/limits.h)"};
 const range VEIL__R_NONNEG = {0, DBL_MAX, false, false, false, "a number >= 0"};
 const range VEIL__R_POS = {0, DBL_MAX, true, false, false, "a number > 0"};
 const range VEIL__R_FOV = {0, 180, true, true, false, "a number of degrees in (0, 180)"};
@@ -152,13 +159,24 @@ veil_result veil__jr_parse_number(const ctx* c, const cJSON* v, const jpath* p, 
     if (!isfinite(x) || (!r->integer && fabs(x) > FLT_MAX))
         return veil__jr_fail_at(c, p, "expected %s, got %s (numbers must be finite and fit in single precision)",
                        r->what, veil__jr_describe(v, buf, sizeof buf));
-    if (!r->integer) x = (double)(float)x; /* what will be stored */
-    bool ok = (r->lo_open ? x > r->lo : x >= r->lo) && (r->hi_open ? x < r->hi : x <= r->hi);
+    /* what will be stored, against the bounds as floats hold them (1e21 is 1.00000002e21 in a float:
+     * the bound itself is accepted) */
+    double lo = r->lo, hi = r->hi;
+    if (!r->integer) x = (double)(float)x, lo = (double)(float)fmax(lo, -FLT_MAX), hi = (double)(float)fmin(hi, FLT_MAX);
+    bool ok = (r->lo_open ? x > lo : x >= lo) && (r->hi_open ? x < hi : x <= hi);
     if (ok && (!r->integer || x == floor(x))) {
         *out = x;
         return VEIL_OK;
     }
     bool positive = r->lo > 0 || (r->lo == 0 && r->lo_open);
+    /* above the range: say so and give the bound (a number > 0 of 3e38 is not "negative or zero") */
+    bool above = r->hi_open ? x >= hi : x > hi;
+    if (above && r->hi < DBL_MAX) {
+        char bound[32];
+        snprintf(bound, sizeof bound, "%.3g", r->hi);
+        return veil__jr_fail_at(c, p, "expected %s, got %s (too large: %s %s)", r->what,
+                                veil__jr_describe(v, buf, sizeof buf), r->hi_open ? "below" : "at most", bound);
+    }
     return veil__jr_fail_at(c, p, "expected %s, got %s%s", r->what, veil__jr_describe(v, buf, sizeof buf),
                    positive && x <= 0 ? " (negative and zero values are not allowed)" : "");
 }

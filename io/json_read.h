@@ -45,6 +45,12 @@ extern const range VEIL__R_ANY;
 extern const range VEIL__R_COORD;     /* positions: scene/limits.h */
 extern const range VEIL__R_LIGHT;     /* intensities, irradiances: scene/limits.h */
 extern const range VEIL__R_SHARPNESS; /* particle sharpness: scene/limits.h */
+extern const range VEIL__R_SIGMA;      /* sigma_a, sigma_s, temperature.intensity: scene/limits.h */
+extern const range VEIL__R_DENSITY;    /* density_scale, amplitudes, fog density: scene/limits.h */
+extern const range VEIL__R_FALLOFF;    /* fog falloff: scene/limits.h */
+extern const range VEIL__R_EMISSION;   /* emission.scale and color: scene/limits.h */
+extern const range VEIL__R_KELVIN;     /* temperature.scale and offset: scene/limits.h */
+extern const range VEIL__R_BACKGROUND; /* background.color: scene/limits.h */
 extern const range VEIL__R_NONNEG;
 extern const range VEIL__R_POS;
 extern const range VEIL__R_FOV;

@@ -33,7 +33,8 @@ static int bad_field(const veil_particle* q, const char** why)
 {
     for (int k = 0; k < 3; ++k)
         if (!(fabsf(q->center[k]) <= (float)VEIL_MAX_COORD)) return *why = "a number in [-1e15, 1e15] (m: scene/limits.h)", k;
-    if (!(isfinite(q->amplitude) && q->amplitude >= 0.0f)) return *why = "a finite number >= 0", 3;
+    if (!(q->amplitude >= 0.0f && q->amplitude <= (float)VEIL_MAX_DENSITY))
+        return *why = "a number in [0, 1e10] (scene/limits.h)", 3;
     if (!(isfinite(q->sharpness) && q->sharpness >= (float)VEIL_MIN_SHARPNESS))
         return *why = "a finite number >= 1e-29 (scene/limits.h)", 4;
     return -1;
@@ -133,7 +134,7 @@ veil_result veil__parse_particle_array(const ctx* c, const cJSON* obj, const jpa
         if (!cJSON_IsObject(e)) return veil__jr_expected(c, &ep, "an object", e);
         TRY(veil__jr_check_keys(c, e, &ep, PARTICLE_KEYS));
         TRY(veil__jr_get_floats_in(c, e, &ep, "center", true, 3, &VEIL__R_COORD, q->center));
-        TRY(veil__jr_get_number(c, e, &ep, "amplitude", true, &VEIL__R_NONNEG, &amp));
+        TRY(veil__jr_get_number(c, e, &ep, "amplitude", true, &VEIL__R_DENSITY, &amp));
         TRY(veil__jr_get_number(c, e, &ep, "sharpness", true, &VEIL__R_SHARPNESS, &sharp));
         q->amplitude = (float)amp, q->sharpness = (float)sharp;
     }

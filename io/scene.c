@@ -69,7 +69,12 @@ static veil_result parse_camera(const ctx* c, const cJSON* root, veil_camera* ca
     cam->fov_y_deg = (float)fov;
     TRY(veil__jr_get_int(c, o, &p, "width", &VEIL__R_SIZE, &cam->width));
     TRY(veil__jr_get_int(c, o, &p, "height", &VEIL__R_SIZE, &cam->height));
-    return check_camera(c, &p, cam);
+    TRY(check_camera(c, &p, cam));
+    /* up is a direction: normalised here, in double (the camera's basis is float, and an up of
+     * [3e38, 1, 0] or [1e-38, 1e-38, 0] overflowed or underflowed its squared length there) */
+    double u[3] = {cam->up[0], cam->up[1], cam->up[2]}, n = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (int i = 0; i < 3; ++i) cam->up[i] = (float)(u[i] / n); /* n > 0: check_camera */
+    return VEIL_OK;
 }
 
 static veil_result parse_phase(const ctx* c, const cJSON* medium, const jpath* mp, veil_phase* ph)
@@ -94,8 +99,8 @@ static veil_result parse_medium(const ctx* c, const cJSON* root, veil_medium* m)
     const cJSON* o;
     TRY(veil__jr_get_container(c, root, &p, true, false, &o));
     TRY(veil__jr_check_keys(c, o, &p, MEDIUM_KEYS));
-    TRY(veil__jr_get_floats(c, o, &p, "sigma_a", false, 3, true, m->sigma_a));
-    TRY(veil__jr_get_floats(c, o, &p, "sigma_s", true, 3, true, m->sigma_s));
+    TRY(veil__jr_get_floats_in(c, o, &p, "sigma_a", false, 3, &VEIL__R_SIGMA, m->sigma_a));
+    TRY(veil__jr_get_floats_in(c, o, &p, "sigma_s", true, 3, &VEIL__R_SIGMA, m->sigma_s));
     TRY(parse_phase(c, o, &p, &m->phase));
     TRY(veil__jr_get_int(c, o, &p, "max_resolution", &VEIL__R_RES, &m->max_resolution));
     m->max_resolution_set = cJSON_GetObjectItemCaseSensitive(o, "max_resolution") != NULL;
@@ -165,7 +170,7 @@ static veil_result parse_background(const ctx* c, const cJSON* root, float color
     TRY(veil__jr_get_container(c, root, &p, false, false, &o));
     if (!o) return VEIL_OK;
     TRY(veil__jr_check_keys(c, o, &p, BACKGROUND_KEYS));
-    return veil__jr_get_floats(c, o, &p, "color", false, 3, true, color);
+    return veil__jr_get_floats_in(c, o, &p, "color", false, 3, &VEIL__R_BACKGROUND, color);
 }
 
 static veil_result parse_root(const ctx* c, const cJSON* root, veil_scene* s)

@@ -2,6 +2,7 @@
  * veil_multiple; docs/scene-format.md lists every field with its unit).
  * Absent fields keep veil_multiple_defaults(). */
 #include "scene_multiple.h"
+#include "../scene/limits.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -17,8 +18,9 @@ static const char* const VOL_METHODS[] = {"octave", "diffusion", NULL}; /* = vei
 static const char* const FILTERS[] = {"2x2", "4x4", "6x6", NULL};                                 /* = veil_spread_filter */
 static const char* const INTERPS[] = {"linear-bilinear", "linear-bicubic", "cubic-bicubic", NULL}; /* = veil_spread_interp */
 
-static const range R_POS = {0, 1e30, true, false, false, "a number > 0"};
-static const range R_NONNEG = {0, 1e30, false, false, false, "a number >= 0"};
+/* the spread's numbers: within VEIL_MAX_SPREAD (scene/limits.h) */
+static const range R_POS = {0, VEIL_MAX_SPREAD, true, false, false, "a number in (0, 1e30] (scene/limits.h)"};
+static const range R_NONNEG = {0, VEIL_MAX_SPREAD, false, false, false, "a number in [0, 1e30] (scene/limits.h)"};
 static const range R_LEVELS = {0, VEIL_SPREAD_MAX_LEVEL, false, false, true, "an integer in [0, 12] (0: from the image size)"};
 static const range R_UNIT_CLOSED = {0, 1, false, false, false, "a number in [0, 1]"};
 static const range R_UNIT_OPEN_LO = {0, 1, true, false, false, "a number in (0, 1]"};
@@ -60,8 +62,8 @@ static veil_result get_weights(const ctx* c, const cJSON* o, const jpath* pp, ve
     TRY(veil__jr_parse_floats(c, v, &p, n, true, w));
     double sum = 0;
     for (int i = 0; i < n; ++i) sum += w[i];
-    if (!(sum > 0) || !(sum < 1e30))
-        return veil__jr_fail_at(c, &p, "expected %d weights with a positive finite sum (they are normalised)", n);
+    if (!(sum > 0) || !(sum <= VEIL_MAX_SPREAD))
+        return veil__jr_fail_at(c, &p, "expected %d weights with a sum in (0, 1e30] (they are normalised: scene/limits.h)", n);
     for (int i = 0; i < 6; ++i) m->weights[i] = i < n ? (float)(w[i] / sum) : 0.0f;
     return VEIL_OK;
 }

@@ -58,7 +58,7 @@ static veil_result parse_random(const ctx* c, const cJSON* so, const jpath* sp, 
     if (!(d->radius[0] > 0 && d->radius[0] <= d->radius[1] && isfinite(1.0f / d->radius[0])))
         return veil__jr_fail_at(c, &rp, "expected [r0, r1] with 0 < r0 <= r1 (metres), got [%g, %g]",
                        d->radius[0], d->radius[1]);
-    TRY(veil__jr_get_floats(c, so, sp, "amplitude", true, 2, true, d->amplitude));
+    TRY(veil__jr_get_floats_in(c, so, sp, "amplitude", true, 2, &VEIL__R_DENSITY, d->amplitude));
     if (d->amplitude[0] > d->amplitude[1])
         return veil__jr_fail_at(c, &ap, "expected [c0, c1] with 0 <= c0 <= c1, got [%g, %g]",
                        d->amplitude[0], d->amplitude[1]);
@@ -168,7 +168,7 @@ static veil_result parse_vdb(const ctx* c, const cJSON* so, const jpath* sp, vei
     }
     TRY(get_string(c, so, sp, "grid", false, &v->grid));
     double scale = 1.0;
-    TRY(veil__jr_get_number(c, so, sp, "density_scale", false, &VEIL__R_NONNEG, &scale));
+    TRY(veil__jr_get_number(c, so, sp, "density_scale", false, &VEIL__R_DENSITY, &scale));
     v->density_scale = (float)scale;
     char* ls = NULL;
     TRY(get_string(c, so, sp, "level_set", false, &ls));
@@ -187,9 +187,9 @@ static veil_result parse_vdb(const ctx* c, const cJSON* so, const jpath* sp, vei
         TRY(veil__jr_check_keys(c, to, &tp, TEMPERATURE_KEYS));
         TRY(get_string(c, to, &tp, "grid", true, &v->temperature_grid));
         double ts = 1.0, toff = 0.0, ti = -1.0;
-        TRY(veil__jr_get_number(c, to, &tp, "scale", false, &VEIL__R_ANY, &ts));
-        TRY(veil__jr_get_number(c, to, &tp, "offset", false, &VEIL__R_ANY, &toff));
-        TRY(veil__jr_get_number(c, to, &tp, "intensity", false, &VEIL__R_NONNEG, &ti));
+        TRY(veil__jr_get_number(c, to, &tp, "scale", false, &VEIL__R_KELVIN, &ts));
+        TRY(veil__jr_get_number(c, to, &tp, "offset", false, &VEIL__R_KELVIN, &toff));
+        TRY(veil__jr_get_number(c, to, &tp, "intensity", false, &VEIL__R_SIGMA, &ti));
         v->temperature_scale = (float)ts, v->temperature_offset = (float)toff, v->temperature_intensity = (float)ti;
     }
     /* "emission": {"grid": name (required), "scale": >= 0 (1), "color": [3] >= 0 ([1, 1, 1])} */
@@ -200,18 +200,26 @@ static veil_result parse_vdb(const ctx* c, const cJSON* so, const jpath* sp, vei
     TRY(veil__jr_check_keys(c, eo, &ep, EMISSION_KEYS));
     TRY(get_string(c, eo, &ep, "grid", true, &v->emission_grid));
     double es = 1.0;
-    TRY(veil__jr_get_number(c, eo, &ep, "scale", false, &VEIL__R_NONNEG, &es));
+    TRY(veil__jr_get_number(c, eo, &ep, "scale", false, &VEIL__R_EMISSION, &es));
     v->emission_scale = (float)es;
     v->emission_color[0] = v->emission_color[1] = v->emission_color[2] = 1.0f;
-    return veil__jr_get_floats(c, eo, &ep, "color", false, 3, true, v->emission_color);
+    TRY(veil__jr_get_floats_in(c, eo, &ep, "color", false, 3, &VEIL__R_EMISSION, v->emission_color));
+    /* eps = scale x value x color: a value of 1 must stay within the bound (scene/limits.h) */
+    for (int k = 0; k < 3; ++k)
+        if ((double)v->emission_scale * v->emission_color[k] > (double)(float)VEIL_MAX_EMISSION) /* the bound as stored */
+            return veil__jr_fail_at(c, &(jpath){&ep, "scale", 0}, "scale x color[%d] = %g x %g = %g W m^-3 sr^-1 "
+                                    "for a value of 1, over the bound of 1e21 (scene/limits.h)", k,
+                                    (double)v->emission_scale, (double)v->emission_color[k],
+                                    (double)v->emission_scale * v->emission_color[k]);
+    return VEIL_OK;
 }
 
 static veil_result parse_fog(const ctx* c, const cJSON* so, const jpath* sp, veil_exp_fog* f)
 {
     const jpath dp = {sp, "direction", 0};
     double density, falloff;
-    TRY(veil__jr_get_number(c, so, sp, "density", true, &VEIL__R_NONNEG, &density));
-    TRY(veil__jr_get_number(c, so, sp, "falloff", true, &VEIL__R_NONNEG, &falloff));
+    TRY(veil__jr_get_number(c, so, sp, "density", true, &VEIL__R_DENSITY, &density));
+    TRY(veil__jr_get_number(c, so, sp, "falloff", true, &VEIL__R_FALLOFF, &falloff));
     f->density = (float)density, f->falloff = (float)falloff;
     TRY(veil__jr_get_floats(c, so, sp, "direction", true, 3, false, f->direction));
     double len = sqrt((double)f->direction[0] * f->direction[0] + (double)f->direction[1] * f->direction[1] +

@@ -61,6 +61,7 @@ struct veil_vdb {
     CoordBBox active_box;        // computed once: the grid does not change
     openvdb::Index64 active = 0;
     std::string others;          // the file's other grids, "name (type)", comma-separated
+    veil_vdb_values values{};    // the active values' range (all finite: checked when opened)
 };
 
 namespace {
@@ -317,13 +318,92 @@ GridBase::Ptr choose(const std::string& path, const openvdb::GridPtrVec& grids, 
 }
 
 // Inactive values (voxels, tiles, background) become 0: only active voxels
-// carry density. Fog volumes already have this form.
+// carry density. Fog volumes already have this form. Each leaf's inactive
+// voxels are found from its mask and its buffer written directly; a tree
+// iterator over every inactive value (the tiles' too) took 7-10 ms of the
+// 18 ms it takes to open the shared smoke.vdb, this 3 ms.
 void zero_inactive(FloatGrid& grid)
 {
     FloatGrid::TreeType& tree = grid.tree();
     if (tree.background() != 0.0f) tree.root().setBackground(0.0f, true);
-    for (FloatGrid::ValueOffIter it = grid.beginValueOff(); it; ++it)
+    for (auto leaf = tree.beginLeaf(); leaf; ++leaf) {
+        float* d = leaf->buffer().data();
+        for (auto off = leaf->getValueMask().beginOff(); off; ++off) d[off.pos()] = 0.0f;
+    }
+    FloatGrid::ValueOffIter it = grid.beginValueOff();
+    it.setMaxDepth(FloatGrid::ValueOffIter::LEAF_DEPTH - 1); // the inactive tiles above the leaves
+    for (; it; ++it)
         if (*it != 0.0f) it.setValue(0.0f);
+}
+
+// Calls f(value, voxels, leaf, offset[, coord]) for every value a voxel
+// reads: each leaf's whole buffer (its inactive values are 0 by now:
+// zero_inactive), then the active tiles above the leaves (voxels: the
+// tile's voxel count, leaf NULL, coord its origin). For the refusals'
+// counts and indices; scan_values below is the fast pass.
+template <typename F>
+void each_value(const FloatGrid& grid, F&& f)
+{
+    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
+        const float* d = leaf->buffer().data();
+        for (openvdb::Index i = 0; i < FloatGrid::TreeType::LeafNodeType::SIZE; ++i)
+            f(d[i], 1, leaf.getLeaf(), i);
+    }
+    FloatGrid::ValueOnCIter it = grid.cbeginValueOn();
+    it.setMaxDepth(FloatGrid::ValueOnCIter::LEAF_DEPTH - 1); // tiles only
+    for (; it; ++it) f(*it, it.getVoxelCount(), nullptr, (openvdb::Index)0, it.getCoord());
+}
+
+// The values' range, 0 included, and how many voxels are below 0; a value
+// that is not a number or infinite is refused, with how many voxels hold
+// one and where the first is (scene/limits.h: one pass over the values
+// already in memory, each leaf's buffer as an array the compiler
+// vectorises: 1.6 ms for the 3 117 leaves of the shared smoke.vdb; a tree
+// iterator over its active voxels took 6-10 ms).
+veil_vdb_values scan_values(const FloatGrid& grid, const std::string& where)
+{
+    using Leaf = FloatGrid::TreeType::LeafNodeType;
+    veil_vdb_values out{};
+    openvdb::Index64 bad = 0;
+    float lo = 0.0f, hi = 0.0f;
+    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
+        const float* d = leaf->buffer().data();
+        float l = 0.0f, h = 0.0f;
+        unsigned neg = 0, nonfinite = 0;
+        for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
+            const float x = d[i];
+            nonfinite += !(x - x == 0.0f); // NaN for NaN and +-inf
+            neg += x < 0.0f;
+            l = x < l ? x : l;
+            h = x > h ? x : h;
+        }
+        bad += nonfinite, out.negative += neg;
+        lo = std::min(lo, l), hi = std::max(hi, h);
+    }
+    FloatGrid::ValueOnCIter tile = grid.cbeginValueOn();
+    tile.setMaxDepth(FloatGrid::ValueOnCIter::LEAF_DEPTH - 1); // the active tiles above the leaves
+    for (; tile; ++tile) {
+        const float x = *tile;
+        if (!std::isfinite(x)) bad += tile.getVoxelCount();
+        else if (x < 0.0f) out.negative += tile.getVoxelCount();
+        if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
+    }
+    if (bad > 0) {
+        Coord first;
+        float first_value = 0.0f;
+        each_value(grid, [&](float x, openvdb::Index64, const Leaf* leaf, openvdb::Index i, Coord c = Coord()) {
+            if (!std::isfinite(x) && std::isfinite(first_value)) first = leaf ? leaf->offsetToGlobalCoord(i) : c, first_value = x;
+        });
+        char text[32];
+        fail_with(VEIL_ERR_INVALID,
+                  where + ": " + std::to_string(bad) + (bad == 1 ? " voxel is" : " voxels are") +
+                      " not a number or infinite (" + (bad == 1 ? "" : "the first ") + "at index [" +
+                      std::to_string(first[0]) + ", " + std::to_string(first[1]) + ", " + std::to_string(first[2]) +
+                      "]: " + veil_number_text(first_value, text, sizeof text) +
+                      "); veil reads finite values only (scene/limits.h)");
+    }
+    out.min = lo, out.max = hi;
+    return out;
 }
 
 void to_column_matrix(const openvdb::math::Transform& t, double m[4][4])
@@ -490,10 +570,11 @@ veil_result veil_vdb_open(const char* path, const char* grid_name, int level_set
         if (!grid) fail_with(VEIL_ERR_IO, where + ": OpenVDB returned no float grid");
         if (grid->getGridClass() == openvdb::GRID_LEVEL_SET) openvdb::tools::sdfToFogVolume(*grid);
         zero_inactive(*grid);
+        const veil_vdb_values values = scan_values(*grid, where);
         std::string others;
         for (const auto& g : metas)
             if (g->getName() != name) others += (others.empty() ? "" : ", ") + g->getName() + " (" + g->valueType() + ")";
-        v = new veil_vdb{path, name, grid, grid->evalActiveVoxelBoundingBox(), grid->activeVoxelCount(), others};
+        v = new veil_vdb{path, name, grid, grid->evalActiveVoxelBoundingBox(), grid->activeVoxelCount(), others, values};
     });
     if (r != VEIL_OK) return r;
     copy_name(v->name, chosen_name, chosen_len);
@@ -511,6 +592,21 @@ void veil_vdb_close(veil_vdb* v)
 const char* veil_vdb_path(const veil_vdb* v) { return v ? v->path.c_str() : ""; }
 const char* veil_vdb_grid_name(const veil_vdb* v) { return v ? v->name.c_str() : ""; }
 const char* veil_vdb_other_grids(const veil_vdb* v) { return v ? v->others.c_str() : ""; }
+
+void veil_vdb_value_range(const veil_vdb* v, veil_vdb_values* out)
+{
+    if (out) *out = v ? v->values : veil_vdb_values{};
+}
+
+uint64_t veil_vdb_count_outside(const veil_vdb* v, double lo, double hi)
+{
+    uint64_t n = 0;
+    if (v)
+        each_value(*v->grid, [&](float x, openvdb::Index64 k, const void*, openvdb::Index, Coord = Coord()) {
+            if (x < lo || x > hi) n += k;
+        });
+    return n;
+}
 
 veil_result veil_vdb_transform(const veil_vdb* v, double index_to_world[4][4], veil_error* err)
 {

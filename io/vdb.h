@@ -48,7 +48,8 @@ typedef struct veil_vdb veil_vdb;
  * narrow band, 1 inside).
  * Errors: VEIL_ERR_IO (missing, unreadable, corrupt or truncated file),
  * VEIL_ERR_INVALID (no such grid: the message lists the file's grids; not
- * a float grid: it names the value type; a level set without the flag),
+ * a float grid: it names the value type; a level set without the flag; an
+ * active value that is not a number or infinite: veil_vdb_value_range),
  * VEIL_ERR_OOM. */
 veil_result veil_vdb_open(const char* path, const char* grid_name, int level_set_to_fog, veil_vdb** out,
                           char* chosen_name, size_t chosen_len, veil_error* err);
@@ -71,6 +72,22 @@ const char* veil_vdb_grid_name(const veil_vdb* v);
  * none): what was not read, for reports (velocity grids and the like are
  * ignored unless a source asks for them). Owned by v. */
 const char* veil_vdb_other_grids(const veil_vdb* v);
+
+/* The active values (voxels, and active tiles counted by their voxels), as
+ * veil_vdb_open read them: their range, 0 included (inactive voxels read
+ * 0), and how many are below 0. veil_vdb_open refuses a grid holding a
+ * value that is not a number or infinite (VEIL_ERR_INVALID, naming the
+ * file, the grid, how many voxels and the first one's index), so every
+ * value is finite. What a value may be beyond that depends on what it is
+ * (density, emission, temperature): volume/vdb_volume.h, scene/limits.h. */
+typedef struct veil_vdb_values {
+    double min, max;
+    uint64_t negative;
+} veil_vdb_values;
+void veil_vdb_value_range(const veil_vdb* v, veil_vdb_values* out);
+/* Active voxels (a tile counts its voxels) whose value is below lo or above
+ * hi: one pass over the values, for messages. */
+uint64_t veil_vdb_count_outside(const veil_vdb* v, double lo, double hi);
 
 /* The affine index-to-world map as a 4x4 matrix acting on column vectors:
  * world[r] = sum_c m[r][c] * (i, j, k, 1)[c]; the last row is 0 0 0 1.

@@ -1,6 +1,9 @@
 #include "blackbody.h"
 
 #include <math.h>
+#include <stdlib.h>
+
+#include "../scene/limits.h"
 
 /* A piecewise Gaussian: sigma1 left of the peak mu, sigma2 right of it (nm). */
 static double lobe(double l, double mu, double s1, double s2)
@@ -52,4 +55,46 @@ void veil_blackbody_xy(double kelvin, double* x, double* y)
     double s = xyz[0] + xyz[1] + xyz[2];
     *x = s > 0.0 ? xyz[0] / s : 0.0;
     *y = s > 0.0 ? xyz[1] / s : 0.0;
+}
+
+/* Entry i's kelvin: linear, then geometric. */
+static double node(int i)
+{
+    if (i < VEIL_BLACKBODY_LINEAR) return i * VEIL_BLACKBODY_STEP;
+    return VEIL_BLACKBODY_LINEAR_END * pow(VEIL_BLACKBODY_RATIO, i - (VEIL_BLACKBODY_LINEAR - 1));
+}
+
+double* veil_blackbody_table(void)
+{
+    double* table = malloc(VEIL_BLACKBODY_ENTRIES * 3 * sizeof *table);
+    for (int i = 0; table && i < VEIL_BLACKBODY_ENTRIES; ++i) veil_blackbody_rgb(node(i), table + 3 * i);
+    return table;
+}
+
+void veil_blackbody_lookup(const double* table, double kelvin, double rgb[3])
+{
+    if (!(kelvin > 0.0)) {
+        rgb[0] = rgb[1] = rgb[2] = 0.0;
+        return;
+    }
+    int i;
+    if (kelvin < VEIL_BLACKBODY_LINEAR_END) {
+        i = (int)(kelvin / VEIL_BLACKBODY_STEP);
+    } else {
+        double u = log(kelvin / VEIL_BLACKBODY_LINEAR_END) / log(VEIL_BLACKBODY_RATIO);
+        if (!(u < VEIL_BLACKBODY_GEOMETRIC)) {
+            veil_blackbody_rgb(kelvin, rgb);
+            return;
+        }
+        i = VEIL_BLACKBODY_LINEAR - 1 + (int)u;
+        /* u's rounding may put kelvin a hair outside [node(i), node(i + 1)]: step to the right one */
+        if (i > VEIL_BLACKBODY_LINEAR - 1 && kelvin < node(i)) --i;
+        if (i + 1 < VEIL_BLACKBODY_ENTRIES - 1 && kelvin >= node(i + 1)) ++i;
+    }
+    if (i >= VEIL_BLACKBODY_ENTRIES - 1) {
+        veil_blackbody_rgb(kelvin, rgb);
+        return;
+    }
+    double t0 = node(i), f = (kelvin - t0) / (node(i + 1) - t0);
+    for (int c = 0; c < 3; ++c) rgb[c] = table[3 * i + c] + f * (table[3 * (i + 1) + c] - table[3 * i + c]);
 }

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "../core/shared.glsl.h"
+#include "../scene/limits.h"
 
 typedef struct emitter {
     float key;   /* the coordinate a split sorts on */
@@ -48,7 +49,11 @@ veil_result veil_emission_lights(const veil_grid* g, const float* rgba, int max,
         int x = (int)(i % (size_t)g->dims[0]), y = (int)(i / (size_t)g->dims[0] % (size_t)g->dims[1]),
             z = (int)(i / ((size_t)g->dims[0] * (size_t)g->dims[1]));
         veil_grid_center(g, x, y, z, pts + 6 * k);
-        for (int c = 0; c < 3; ++c) pts[6 * k + 3 + (size_t)c] = (float)(e[c] * dv);
+        /* eps dV in double, within VEIL_MAX_LIGHT, its colour kept (a voxel of 1e15 m has dV = 1e45: a
+         * float overflows) */
+        double p[3] = {e[0] * dv, e[1] * dv, e[2] * dv}, most = fmax(p[0], fmax(p[1], p[2]));
+        double keep = most > VEIL_MAX_LIGHT ? VEIL_MAX_LIGHT / most : 1.0;
+        for (int c = 0; c < 3; ++c) pts[6 * k + 3 + (size_t)c] = (float)(p[c] * keep);
         ++k;
     }
     veil_result r = veil_emission_lights_points(pts, count, g->voxel, max, out, n, err);
@@ -66,7 +71,14 @@ veil_result veil_emission_lights_points(const float* pts, size_t count, float vo
     if (!em) return veil_fail(err, VEIL_ERR_OOM, "out of memory for %zu emitting voxels", count);
     size_t k = 0;
     for (size_t i = 0; i < count; ++i) {
-        const float* e = pts + 6 * i + 3;
+        /* each voxel's eps dV within VEIL_MAX_LIGHT, its colour kept where it is finite (an infinite
+         * channel becomes the bound, the others 0; NaN: no light) */
+        const float* q = pts + 6 * i + 3;
+        float e[3], most = fmaxf(q[0], fmaxf(q[1], q[2]));
+        for (int a = 0; a < 3; ++a)
+            e[a] = !(most > (float)VEIL_MAX_LIGHT) ? q[a]
+                   : isinf(most)                 ? (isinf(q[a]) ? (float)VEIL_MAX_LIGHT : 0.0f)
+                                                 : (float)((double)q[a] * (VEIL_MAX_LIGHT / most));
         double lum = VEIL_LUM_R * e[0] + VEIL_LUM_G * e[1] + VEIL_LUM_B * e[2];
         if (!(lum > 0.0)) continue;
         for (int a = 0; a < 3; ++a) em[k].p[a] = pts[6 * i + (size_t)a], em[k].e[a] = e[a];
@@ -118,7 +130,9 @@ veil_result veil_emission_lights_points(const float* pts, size_t count, float vo
         veil_light* l = &out[(*n)++];
         memset(l, 0, sizeof *l);
         l->type = VEIL_LIGHT_POINT;
-        for (int a = 0; a < 3; ++a) l->position[a] = (float)p[a], l->color[a] = (float)e[a];
+        /* an intensity within VEIL_MAX_LIGHT, as every light's (scene/limits.h): scaled down whole, its colour kept */
+        double most = fmax(e[0], fmax(e[1], e[2])), keep = most > VEIL_MAX_LIGHT ? VEIL_MAX_LIGHT / most : 1.0;
+        for (int a = 0; a < 3; ++a) l->position[a] = (float)p[a], l->color[a] = (float)(e[a] * keep);
         /* the cluster as a uniform ball of the same second moment: a voxel's own spread (a ball of
          * its volume, radius 0.62 h: (3/5) 0.62^2 h^2) adds to its centres' (a union's second moment is
          * the sum); a ball's mean intensity at its centre, eps R, equals a point's I / (4 pi r^2) at

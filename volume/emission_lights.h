@@ -14,6 +14,12 @@
  *
  * The light emitted straight to the camera stays the march's own (the
  * emission texture); these lights carry what the medium scatters of it.
+ *
+ * Each voxel's eps dV and each light's intensity are held within
+ * VEIL_MAX_LIGHT per channel (scene/limits.h), a light's colour kept, so
+ * that the lights' derivation there holds for these too (a +inf or huge
+ * voxel otherwise made an infinite light, a NaN position and runaway
+ * propagation shells).
  */
 #ifndef VEIL_EMISSION_LIGHTS_H
 #define VEIL_EMISSION_LIGHTS_H

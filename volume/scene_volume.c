@@ -9,6 +9,7 @@
 
 #include "../core/hash.h"
 #include "../core/progress.h"
+#include "../scene/limits.h"
 #include "blackbody.h"
 #include "sparse.h"
 #include "vdb_volume.h"
@@ -51,8 +52,16 @@ static veil_result open_emission(veil_scene_volume* v, const veil_source* src, s
     es->temperature = temperature;
     es->density = v->vdb_count - 1;
     es->t_scale = src->vdb.temperature_scale, es->t_offset = src->vdb.temperature_offset;
-    for (int c = 0; c < 3; ++c)
+    double most = 0.0; /* the largest emission factor, for the values' bound */
+    for (int c = 0; c < 3; ++c) {
         es->factor[c] = temperature ? src->vdb.temperature_intensity : src->vdb.emission_scale * src->vdb.emission_color[c];
+        most = fmax(most, (double)es->factor[c]);
+    }
+    r = temperature ? veil_vdb_check_values(e, VEIL_VALUES_TEMPERATURE, es->t_scale, es->t_offset, &inner)
+                    : veil_vdb_check_values(e, VEIL_VALUES_EMISSION, most, 0.0, &inner);
+    if (r != VEIL_OK)
+        return veil_fail(err, r, "medium.sources[%zu].%s.grid: %.1900s", i, temperature ? "temperature" : "emission",
+                         inner.msg);
     int ilo[3], ihi[3];
     size_t active = 0;
     r = veil_vdb_index_bbox(e, ilo, ihi, &active);
@@ -84,6 +93,8 @@ static veil_result open_vdb(veil_scene_volume* v, const veil_source* src, size_t
     if (r != VEIL_OK) return veil_fail(err, r, "medium.sources[%zu]: %.1900s", i, inner.msg);
     v->vdbs[v->vdb_count] = vdb;
     v->vdb_scale[v->vdb_count++] = src->vdb.density_scale;
+    r = veil_vdb_check_values(vdb, VEIL_VALUES_DENSITY, src->vdb.density_scale, 0.0, &inner);
+    if (r != VEIL_OK) return veil_fail(err, r, "medium.sources[%zu]: %.1900s", i, inner.msg);
     int ilo[3], ihi[3];
     size_t active = 0;
     r = veil_vdb_index_bbox(vdb, ilo, ihi, &active);
@@ -99,32 +110,7 @@ static veil_result open_vdb(veil_scene_volume* v, const veil_source* src, size_t
     return r;
 }
 
-#define BB_STEP 10.0     /* K between table entries */
-#define BB_ENTRIES 2001  /* 0 .. 20 000 K */
-
-/* kelvin -> rgb through the table, directly beyond it. */
-static void blackbody(const double (*table)[3], double kelvin, double rgb[3])
-{
-    if (!(kelvin > 0.0)) {
-        rgb[0] = rgb[1] = rgb[2] = 0.0;
-        return;
-    }
-    double u = kelvin / BB_STEP;
-    if (u >= BB_ENTRIES - 1) {
-        veil_blackbody_rgb(kelvin, rgb);
-        return;
-    }
-    int i = (int)u;
-    double f = u - i;
-    for (int c = 0; c < 3; ++c) rgb[c] = table[i][c] + f * (table[i + 1][c] - table[i][c]);
-}
-
-double* veil_emission_table(void)
-{
-    double* table = malloc(BB_ENTRIES * 3 * sizeof *table);
-    for (int t = 0; table && t < BB_ENTRIES; ++t) veil_blackbody_rgb(t * BB_STEP, table + 3 * t);
-    return table;
-}
+double* veil_emission_table(void) { return veil_blackbody_table(); }
 
 void veil_emission_eps(const veil_scene_volume* v, const veil_emission_source* es, const double* table, float value,
                        float rho, float eps[3])
@@ -136,10 +122,14 @@ void veil_emission_eps(const veil_scene_volume* v, const veil_emission_source* e
     eps[0] = eps[1] = eps[2] = 0.0f;
     if (!(rho > 0.0f)) return;
     double bb[3];
-    blackbody((const double(*)[3])table, (double)es->t_scale * value + es->t_offset, bb);
+    veil_blackbody_lookup(table, (double)es->t_scale * value + es->t_offset, bb);
     for (int c = 0; c < 3; ++c) {
         double kc = es->factor[c] >= 0.0f ? es->factor[c] : v->sigma_a[c];
-        eps[c] = (float)(kc * rho * bb[c]);
+        /* k rho B within max(VEIL_MAX_EMISSION, sigma_a rho B) (scene/limits.h): Kirchhoff's emission
+         * (k <= sigma_a) as it is, its radiance under B; a larger k (<= 1e10) at rho <= 1e10 and
+         * B(1e5 K) = 2e9 could make 2e29, more than a ray can sum under FLT_MAX */
+        double e = kc * rho * bb[c], cap = fmax(VEIL_MAX_EMISSION, (double)v->sigma_a[c] * rho * bb[c]);
+        eps[c] = (float)fmin(e, cap);
     }
 }
 
@@ -157,7 +147,8 @@ veil_result veil_scene_volume_emission(const veil_scene_volume* v, float** rgba,
     for (int i = 0; i < v->emission_count && r == VEIL_OK; ++i) {
         const veil_emission_source* es = &v->emission[i];
         memset(one, 0, n * sizeof *one);
-        r = veil_vdb_to_grid(es->grid, 1.0f, &v->grid, one, err);
+        r = es->temperature ? veil_vdb_to_grid_signed(es->grid, 1.0f, &v->grid, one, err)
+                            : veil_vdb_to_grid(es->grid, 1.0f, &v->grid, one, err);
         if (r == VEIL_OK && es->temperature) {
             memset(rho, 0, n * sizeof *rho);
             r = veil_vdb_to_grid(v->vdbs[es->density], v->vdb_scale[es->density], &v->grid, rho, err);
@@ -423,6 +414,19 @@ static void note_unread(veil_scene_volume* v, int i)
         snprintf(v->resolution + len, sizeof v->resolution - len, "; not read: %s", unread);
 }
 
+/* Appends to v->resolution how many voxels of `grid` below 0 read as 0 (a
+ * density or emission: scene/limits.h); short, as --stats gives the stage
+ * 255 characters. */
+static void note_negative(veil_scene_volume* v, const veil_vdb* grid)
+{
+    veil_vdb_values x;
+    veil_vdb_value_range(grid, &x);
+    size_t len = strlen(v->resolution);
+    if (x.negative > 0 && len + 32 < sizeof v->resolution)
+        snprintf(v->resolution + len, sizeof v->resolution - len, "; grid '%s': %llu voxel%s below 0 read as 0",
+                 veil_vdb_grid_name(grid), (unsigned long long)x.negative, x.negative == 1 ? "" : "s");
+}
+
 veil_result veil_scene_volume_open(const veil_scene* s, veil_scene_volume* out, veil_error* err)
 {
     veil_scene_volume v;
@@ -449,6 +453,9 @@ veil_result veil_scene_volume_open(const veil_scene* s, veil_scene_volume* out, 
         r = veil_vdb_plan_resample(i < v.vdb_count ? v.vdbs[i] : v.emission[i - v.vdb_count].grid, &v.grid, &plan, err);
     }
     /* say which grids of the files were not read (velocity and the like) */
+    for (int i = 0; i < v.vdb_count && r == VEIL_OK; ++i) note_negative(&v, v.vdbs[i]);
+    for (int i = 0; i < v.emission_count && r == VEIL_OK; ++i)
+        if (!v.emission[i].temperature) note_negative(&v, v.emission[i].grid);
     for (int i = 0; i < v.vdb_count && r == VEIL_OK; ++i) note_unread(&v, i);
     if (r != VEIL_OK) {
         veil_scene_volume_close(&v);

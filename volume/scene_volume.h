@@ -59,17 +59,17 @@ typedef struct veil_scene_volume {
 
 /* The emission on v->grid: a newly calloc'd *rgba (4 floats a voxel: the
  * emission coefficient eps per channel, W m^-3 sr^-1, and 0), each grid
- * resampled as the density is (veil_vdb_to_grid). A temperature grid
- * emits k rho B_rgb(kelvin) (volume/blackbody.h; B tabulated every 10 K to
- * 20 000 K and interpolated linearly, computed directly above). NULL when
- * there is none. */
+ * resampled as the density is (veil_vdb_to_grid: an emission value below 0
+ * reads 0). A temperature grid emits k rho B_rgb(kelvin) (volume/blackbody.h:
+ * veil_blackbody_table), capped at VEIL_MAX_EMISSION (scene/limits.h).
+ * NULL when there is none. */
 veil_result veil_scene_volume_emission(const veil_scene_volume* v, float** rgba, veil_error* err);
 
 /* What that adds per voxel, for the sparse volume too: eps (W m^-3 sr^-1)
  * of emission source es where its grid reads `value` and its density is
  * rho (a temperature grid emits only where rho > 0), with the blackbody
- * table of veil_emission_table (3 doubles every 10 K to 20 000 K; malloc'd,
- * NULL out of memory). */
+ * table of veil_emission_table (veil_blackbody_table; malloc'd, NULL out
+ * of memory). */
 double* veil_emission_table(void);
 void veil_emission_eps(const veil_scene_volume* v, const veil_emission_source* es, const double* table, float value,
                        float rho, float eps[3]);

@@ -29,6 +29,7 @@ typedef struct gather {
     int bricks[3], dims[3];
     int off[3];      /* this source: grid voxel = VDB index + off */
     float scale;
+    int keep_negative; /* 1: a temperature grid's values (else below 0 reads 0: scene/limits.h) */
     uint64_t last_key; /* the last brick found, and its slot (voxels come leaf by leaf) */
     uint32_t last_slot;
     size_t voxels;
@@ -123,6 +124,7 @@ static long long get(gather* g, const int b[3])
 static void add_voxel(void* user, const int ijk[3], float value)
 {
     gather* g = user;
+    if (value < 0.0f && !g->keep_negative) return; /* reads 0: adds nothing, makes no brick */
     int t[3], b[3];
     for (int a = 0; a < 3; ++a) {
         t[a] = ijk[a] + g->off[a];
@@ -190,6 +192,7 @@ static veil_result gather_emission(const veil_scene_volume* v, gather* g, veil_e
         const veil_emission_source* es = &v->emission[i];
         memset(g->one, 0, g->count * B * B * B * sizeof *g->one);
         g->into = g->one, g->scale = 1.0f, g->create = !es->temperature, g->last_key = 0;
+        g->keep_negative = es->temperature;
         r = offset_of(v, es->grid, g->off, err);
         if (r == VEIL_OK) r = veil_vdb_each_voxel(es->grid, add_voxel, g, err);
         if (r == VEIL_OK && g->oom) r = veil_fail(err, VEIL_ERR_OOM, "out of memory for the sparse volume's bricks");
@@ -200,7 +203,7 @@ static veil_result gather_emission(const veil_scene_volume* v, gather* g, veil_e
                 for (int c = 0; c < 3; ++c) g->edata[s * 3 * B * B * B + (size_t)c * B * B * B + k] += eps[c];
             }
     }
-    g->into = NULL, g->create = 1, g->last_key = 0;
+    g->into = NULL, g->create = 1, g->last_key = 0, g->keep_negative = 0;
     free(table);
     return r;
 }

@@ -1,6 +1,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "vdb_volume.h"
 
+#include "../scene/limits.h"
+
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
@@ -241,8 +243,14 @@ veil_result veil_vdb_plan_resample(const veil_vdb* v, const veil_grid* g, veil_v
     return VEIL_OK;
 }
 
-static veil_result copy_values(const veil_vdb* v, float scale, const veil_grid* g, const veil_vdb_resample_plan* p,
-                               float* density, veil_error* err)
+/* Values below 0 read as 0 (a density or an emission: scene/limits.h). */
+static void clamp_negative(float* x, size_t n)
+{
+    for (size_t i = 0; i < n; ++i) x[i] = x[i] < 0.0f ? 0.0f : x[i];
+}
+
+static veil_result copy_values(const veil_vdb* v, float scale, int clamp, const veil_grid* g,
+                               const veil_vdb_resample_plan* p, float* density, veil_error* err)
 {
     vdb_geometry geo;
     veil_result r = geometry(v, &geo, err);
@@ -259,6 +267,7 @@ static veil_result copy_values(const veil_vdb* v, float scale, const veil_grid* 
             r = veil_fail(err, r, "%s: grid '%s': reading its values failed", veil_vdb_path(v), veil_vdb_grid_name(v));
             break;
         }
+        if (clamp) clamp_negative(slab, nx * ny);
         for (size_t j = 0; j < ny; ++j) {
             float* row = density + ((size_t)k * (size_t)g->dims[1] + (size_t)p->lo[1] + j) * (size_t)g->dims[0] +
                          (size_t)p->lo[0];
@@ -337,8 +346,8 @@ static void* filter_slabs(void* arg)
     return NULL;
 }
 
-static veil_result box_filter(const veil_vdb* v, float scale, const veil_grid* g, const veil_vdb_resample_plan* p,
-                              float* density, veil_error* err)
+static veil_result box_filter(const veil_vdb* v, float scale, int clamp, const veil_grid* g,
+                              const veil_vdb_resample_plan* p, float* density, veil_error* err)
 {
     vdb_geometry geo;
     veil_result r = geometry(v, &geo, err);
@@ -360,6 +369,7 @@ static veil_result box_filter(const veil_vdb* v, float scale, const veil_grid* g
         free(val);
         return veil_fail(err, r, "%s: grid '%s': reading its values failed", veil_vdb_path(v), veil_vdb_grid_name(v));
     }
+    if (clamp) clamp_negative(val, p->dense_voxels);
     f.val = val;
 
     /* Target slabs interleaved over threads; each voxel is written by one
@@ -384,8 +394,8 @@ static veil_result box_filter(const veil_vdb* v, float scale, const veil_grid* g
     return VEIL_OK;
 }
 
-veil_result veil_vdb_to_grid(const veil_vdb* v, float density_scale, const veil_grid* g, float* density,
-                             veil_error* err)
+static veil_result to_grid(const veil_vdb* v, float density_scale, int keep_negative, const veil_grid* g,
+                           float* density, veil_error* err)
 {
     if (!v || !g || !density) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_to_grid: missing argument");
     if (!isfinite(density_scale))
@@ -393,8 +403,51 @@ veil_result veil_vdb_to_grid(const veil_vdb* v, float density_scale, const veil_
     veil_vdb_resample_plan plan;
     veil_result r = veil_vdb_plan_resample(v, g, &plan, err);
     if (r != VEIL_OK || plan.samples == 0) return r;
-    return plan.exact_copy ? copy_values(v, density_scale, g, &plan, density, err)
-                           : box_filter(v, density_scale, g, &plan, density, err);
+    veil_vdb_values values;
+    veil_vdb_value_range(v, &values);
+    const int clamp = !keep_negative && values.negative > 0; /* nothing to do for most grids */
+    return plan.exact_copy ? copy_values(v, density_scale, clamp, g, &plan, density, err)
+                           : box_filter(v, density_scale, clamp, g, &plan, density, err);
+}
+
+veil_result veil_vdb_to_grid(const veil_vdb* v, float density_scale, const veil_grid* g, float* density,
+                             veil_error* err)
+{
+    return to_grid(v, density_scale, 0, g, density, err);
+}
+
+veil_result veil_vdb_to_grid_signed(const veil_vdb* v, float scale, const veil_grid* g, float* out, veil_error* err)
+{
+    return to_grid(v, scale, 1, g, out, err);
+}
+
+veil_result veil_vdb_check_values(const veil_vdb* v, veil_values_kind kind, double scale, double offset,
+                                  veil_error* err)
+{
+    static const struct {
+        const char* one, *many, *what, *unit;
+        double bound;
+    } K[] = {
+        {"is too large", "are too large", "value x density_scale", "", VEIL_MAX_DENSITY},
+        {"emits too much", "emit too much", "value x emission.scale x color", " W m^-3 sr^-1", VEIL_MAX_EMISSION},
+        {"is too hot", "are too hot", "temperature.scale x value + offset", " K", VEIL_MAX_KELVIN},
+    };
+    veil_vdb_values x;
+    veil_vdb_value_range(v, &x);
+    if (kind != VEIL_VALUES_TEMPERATURE) { /* below 0 reads 0 */
+        x.min = x.min < 0.0 ? 0.0 : x.min;
+        offset = 0.0;
+    }
+    /* the largest value the grid makes, and the raw values beyond the bound */
+    /* the bound as a float holds it (the scene's scales are floats: 1e21 is 1.00000002e21) */
+    const double hi = fmax(scale * x.min + offset, scale * x.max + offset), bound = (double)(float)K[kind].bound;
+    if (!(hi > bound)) return VEIL_OK;
+    const double edge = (bound - offset) / scale; /* scale != 0 here: else hi = offset <= bound */
+    uint64_t n = scale > 0.0 ? veil_vdb_count_outside(v, -HUGE_VAL, edge) : veil_vdb_count_outside(v, edge, HUGE_VAL);
+    return veil_fail(err, VEIL_ERR_INVALID,
+                     "%s: grid '%s': %llu voxel%s %s: %s up to %.3g%s, over the bound of %.3g%s (scene/limits.h)",
+                     veil_vdb_path(v), veil_vdb_grid_name(v), (unsigned long long)n, n == 1 ? "" : "s",
+                     n == 1 ? K[kind].one : K[kind].many, K[kind].what, hi, K[kind].unit, bound, K[kind].unit);
 }
 
 int veil_vdb_lattice(const veil_vdb* v, double* edge, double origin[3], int* axis_aligned)

@@ -93,9 +93,31 @@ veil_result veil_vdb_plan_resample(const veil_vdb* v, const veil_grid* g, veil_v
 
 /* Adds density_scale x the box-filtered field (above) to `density`
  * (veil_grid_voxels(g) floats, x fastest). Voxels whose cube misses the
- * field's support are left untouched. */
+ * field's support are left untouched. Values below 0 read as 0 (a density
+ * or an emission: scene/limits.h). */
 veil_result veil_vdb_to_grid(const veil_vdb* v, float density_scale, const veil_grid* g, float* density,
                              veil_error* err);
+/* The same keeping values below 0 (a temperature grid, whose offset may
+ * make them hot). */
+veil_result veil_vdb_to_grid_signed(const veil_vdb* v, float scale, const veil_grid* g, float* out, veil_error* err);
+
+/* What a grid's values are, for the bounds of scene/limits.h. */
+typedef enum veil_values_kind {
+    VEIL_VALUES_DENSITY,     /* value x scale (density_scale) <= VEIL_MAX_DENSITY */
+    VEIL_VALUES_EMISSION,    /* value x scale (the largest of emission.scale x color) <= VEIL_MAX_EMISSION */
+    VEIL_VALUES_TEMPERATURE, /* scale x value + offset (kelvin) <= VEIL_MAX_KELVIN */
+} veil_values_kind;
+
+/* Checks the values v holds (veil_vdb_value_range: all finite once opened)
+ * against the bound of their kind, a density or emission value below 0
+ * counting as 0 (as veil_vdb_to_grid reads it). Over it: VEIL_ERR_INVALID
+ * naming the file, the grid, how many voxels pass the bound and the
+ * largest value they make ("...: grid 'heat': 1 voxel emits too much: value
+ * x emission.scale x color up to 3e+38 W m^-3 sr^-1, over the bound of
+ * 1e+21 W m^-3 sr^-1 (scene/limits.h)"). Cheap: the range was found when
+ * the grid was opened; only a refusal counts. */
+veil_result veil_vdb_check_values(const veil_vdb* v, veil_values_kind kind, double scale, double offset,
+                                  veil_error* err);
 
 /* The grid's lattice: 1 and its smallest voxel edge (the world length of
  * one index step along the shortest index axis, m) when it has active

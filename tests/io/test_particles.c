@@ -74,15 +74,16 @@ static void test_round_trips(void)
             float c = random_finite(); /* every mantissa, within scene/limits.h's 1e15 m */
             p[i].center[k] = fabsf(c) <= 1e15f ? c : c * (1e15f / 3.4028235e38f);
         }
-        p[i].amplitude = fabsf(random_finite());
+        float a = fabsf(random_finite()); /* every mantissa, within scene/limits.h's 1e10 */
+        p[i].amplitude = a <= 1e10f ? a : a * (1e10f / 3.4028235e38f);
         float s = fabsf(random_finite());
         p[i].sharpness = s >= 1e-29f ? s : 1.0f;
     }
-    p[0].center[0] = -0.0f, p[1].amplitude = 0.0f, p[2].sharpness = 1e-29f, p[3].amplitude = 3.4028235e38f;
+    p[0].center[0] = -0.0f, p[1].amplitude = 0.0f, p[2].sharpness = 1e-29f, p[3].amplitude = 1e10f;
     /* the longest lines: every field at the largest magnitude it may have, 17 digits each */
     for (size_t i = 10; i < 1010; ++i) {
         for (int k = 0; k < 3; ++k) p[i].center[k] = -nextafterf(1e15f, 0.0f);
-        p[i].amplitude = nextafterf(3.4028235e38f, 0.0f), p[i].sharpness = 3.4028235e38f;
+        p[i].amplitude = nextafterf(1e10f, 0.0f), p[i].sharpness = 3.4028235e38f;
     }
     for (int binary = 0; binary < 2; ++binary) {
         char path[256];
@@ -190,7 +191,11 @@ static void test_bad_binary(void)
     lef(b + 16 + 20 * 1 + 4, 1.0f);
     lef(b + 16 + 20 * 0 + 12, -0.5f); /* particle 0: negative amplitude */
     spit(path, b, size);
-    expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 0: amplitude", ">= 0");
+    expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 0: amplitude", "[0, 1e10]");
+    /* an amplitude of 3e38 is finite, but 1e7 of them or one times sigma overflow (issue 22): refused */
+    lef(b + 16 + 20 * 0 + 12, 3e38f);
+    spit(path, b, size);
+    expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 0: amplitude", "in [0, 1e10] (scene/limits.h), got 3e+38");
     lef(b + 16 + 20 * 0 + 12, INFINITY);
     spit(path, b, size);
     expect_fail(path, VEIL_ERR_INVALID, VEIL_ERR_IO, "particle 0: amplitude", "got infinity");
@@ -220,7 +225,9 @@ static void test_bad_json(void)
         {"{\"format\":\"veil-particles\",\"version\":1,\"particles\":[{\"center\":[0,0,0],\"amplitude\":1,\"sharpness\":2},"
          "{\"center\":[0,0,0],\"amplitude\":1,\"sharpness\":-2}]}", "particles[1].sharpness", "expected a number >= 1e-29"},
         {"{\"format\":\"veil-particles\",\"version\":1,\"particles\":[{\"center\":[0,0,0],\"amplitude\":-1,\"sharpness\":2}]}",
-         "particles[0].amplitude", ">= 0"},
+         "particles[0].amplitude", "in [0, 1e10]"},
+        {"{\"format\":\"veil-particles\",\"version\":1,\"particles\":[{\"center\":[0,0,0],\"amplitude\":3e38,\"sharpness\":2}]}",
+         "particles[0].amplitude", "got 3e+38 (too large: at most 1e+10)"},
         {"{\"format\":\"veil-particles\",\"version\":1,\"particles\":[{\"center\":[0,1e39,0],\"amplitude\":1,\"sharpness\":2}]}",
          "particles[0].center", "single precision"},
         {"{\"format\":\"veil-particles\",\"version\":1,\"particles\":[{\"center\":[0,0],\"amplitude\":1,\"sharpness\":2}]}",

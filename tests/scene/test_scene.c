@@ -7,6 +7,7 @@
 
 #include "support/check.h"
 #include "io/scene.h"
+#include "scene/camera.h"
 
 /* JSON is written with single quotes here; parse() turns them into double. */
 static veil_result parse(const char* name, const char* text, veil_scene* s, veil_error* e)
@@ -40,6 +41,9 @@ static int vec_close(const float* v, double x, double y, double z)
 #define RND(f) "{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'rbf_random'," f "}]}}"
 #define RND_OK_COUNT "'count':3,'seed':1,"
 #define RND_OK_BOUNDS "'bounds':[[0,0,0],[1,1,1]],"
+#define SRC(f) "{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[" f "]}}"
+#define VDB(f) SRC("{'type':'vdb','file':'/dev/null'," f "}") /* any readable file: the grid is not opened */
+#define FOG(f) SRC("{'type':'exponential','direction':[0,1,0],'origin':[0,0,0]," f "}")
 
 static void test_full(void)
 {
@@ -65,7 +69,7 @@ static void test_full(void)
     CHECK(strcmp(s.base_dir, "dir/sub") == 0, "base_dir %s", s.base_dir);
     CHECK(vec_close(s.camera.position, 1, 2, 3), "position");
     CHECK(vec_close(s.camera.look_at, 1, 2, 0), "look_at");
-    CHECK(vec_close(s.camera.up, 0, 0.5, 0), "up");
+    CHECK(vec_close(s.camera.up, 0, 1, 0), "up normalised on load: %g %g %g", s.camera.up[0], s.camera.up[1], s.camera.up[2]);
     CHECK(s.camera.fov_y_deg == 30.0f && s.camera.width == 320 && s.camera.height == 200, "camera");
     CHECK(vec_close(s.medium.sigma_a, 0.1, 0.2, 0.3), "sigma_a");
     CHECK(vec_close(s.medium.sigma_s, 4, 5, 6), "sigma_s");
@@ -187,13 +191,77 @@ static void test_multiple(void)
     }
     veil_scene_free(&s);
     r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'filter':'2x2','weights':[0,0]}}", &s, &e);
-    CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.weights: expected 2 weights with a positive"),
+    CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.weights: expected 2 weights with a sum in (0, 1e30]"),
           "zero weights refused: %s", e.msg);
     r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'c':0}}", &s, &e);
-    CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.c: expected a number > 0"), "c = 0: %s", e.msg);
+    CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.c: expected a number in (0, 1e30]") &&
+              strstr(e.msg, "(negative and zero values are not allowed)"), "c = 0: %s", e.msg);
+    /* issue 22: a number too large for a field says so and gives the bound (it said "expected a number
+     * > 0" of 3e38); every number of the spread within VEIL_MAX_SPREAD (scene/limits.h) */
+    static const char* const SPREAD[] = {"c", "mask_epsilon", "separation_luminance", "separation_luminance_width",
+                                         "separation_density", "separation_density_width", "thin_threshold"};
+    for (size_t i = 0; i < sizeof SPREAD / sizeof SPREAD[0]; ++i) {
+        char json[256], want[160];
+        snprintf(json, sizeof json, "{" CAM "," MED ",'multiple_scattering':{'%s':3e38}}", SPREAD[i]);
+        snprintf(want, sizeof want, "ms.json: multiple_scattering.%s: expected a number in ", SPREAD[i]);
+        r = parse("ms.json", json, &s, &e);
+        CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, want) == e.msg &&
+                  strstr(e.msg, "1e30] (scene/limits.h), got 3e+38 (too large: at most 1e+30)"),
+              "%s = 3e38: %s", SPREAD[i], e.msg);
+    }
+    r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'filter':'2x2','weights':[3e38,3e38]}}", &s, &e);
+    CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.weights: expected 2 weights with a sum in (0, 1e30]"),
+          "weights summing to 6e38: %s", e.msg);
     r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'octave_contribution':1}}", &s, &e);
     CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "octave_contribution: expected a number in [0, 1)"), "b = 1: %s",
           e.msg);
+}
+
+/* camera.up is normalised on load, in double: an up of 3e38 or 1e-38 overflowed or underflowed its
+ * squared length in the float camera basis ("up is parallel to the view direction" at render time). */
+static void test_camera_up(void)
+{
+    static const char* const ups[] = {"[3e38,1,0]", "[0,3e38,3e38]", "[1e-38,1e-38,0]"};
+    static const double want[3][3] = {{1, 0, 0}, {0, 0.70710678, 0.70710678}, {0.70710678, 0.70710678, 0}};
+    for (int i = 0; i < 3; ++i) {
+        char json[256];
+        snprintf(json, sizeof json, "{'camera':{'position':[0,0,5],'look_at':[0,0,0],'up':%s}," MED "}", ups[i]);
+        veil_scene s;
+        veil_error e = {0};
+        veil_result r = parse("up.json", json, &s, &e);
+        CHECK(r == VEIL_OK, "up %s: %s", ups[i], e.msg);
+        if (r != VEIL_OK) continue;
+        CHECK(vec_close(s.camera.up, want[i][0], want[i][1], want[i][2]), "up %s read as %g %g %g", ups[i],
+              s.camera.up[0], s.camera.up[1], s.camera.up[2]);
+        veil_camera_basis b;
+        CHECK(veil_camera_make_basis(&s.camera, 8, 8, &b, &e) == VEIL_OK, "up %s: basis: %s", ups[i], e.msg);
+        veil_scene_free(&s);
+    }
+}
+
+/* Every bound of scene/limits.h is itself accepted (issue 22), and kept as given. */
+static void test_bounds_accepted(void)
+{
+    veil_scene s;
+    veil_error e = {0};
+    veil_result r = parse("bounds.json",
+                          "{" CAM ",'medium':{'sigma_a':[1e10,0,1e10],'sigma_s':[1e10,1e10,0],'sources':["
+                          "{'type':'vdb','file':'/dev/null','density_scale':1e10,"
+                          "'emission':{'grid':'heat','scale':1e21,'color':[1,0.5,0]},"
+                          "'temperature':{'grid':'t','scale':-1e5,'offset':1e5,'intensity':1e10}},"
+                          "{'type':'exponential','density':1e10,'falloff':1e20,'direction':[0,1,0],'origin':[0,0,0]},"
+                          "{'type':'rbf','particles':[{'center':[0,0,0],'amplitude':1e10,'sharpness':1}]}]},"
+                          "'background':{'color':[1e20,0,1e20]},'multiple_scattering':{'c':1e30,'thin_threshold':1e30}}",
+                          &s, &e);
+    CHECK(r == VEIL_OK, "the bounds themselves: %s", e.msg);
+    if (r != VEIL_OK) return;
+    const veil_vdb_source* v = &s.medium.sources[0].vdb;
+    CHECK(s.medium.sigma_a[0] == 1e10f && s.medium.sigma_s[1] == 1e10f && v->density_scale == 1e10f &&
+              v->emission_scale == 1e21f && v->temperature_scale == -1e5f && v->temperature_offset == 1e5f &&
+              v->temperature_intensity == 1e10f && s.medium.sources[1].fog.falloff == 1e20f &&
+              s.medium.sources[2].particles[0].amplitude == 1e10f && s.background[2] == 1e20f && s.multiple.c == 1e30f,
+          "values at the bounds kept as given");
+    veil_scene_free(&s);
 }
 
 typedef struct bad_case {
@@ -204,6 +272,40 @@ typedef struct bad_case {
 } bad_case;
 
 static const bad_case BAD[] = {
+    /* scene/limits.h (issue 22): the medium's coefficients and every scale, refused at load by name
+     * (sigma_s 3e38 and sigma_a 1e20 made NaN pixels; emission.scale and temperature.scale 3e38
+     * Inf and NaN pixels, or a render past 60 s) */
+    {"{" CAM ",'medium':{'sigma_a':[1e20,0,0],'sigma_s':[1,1,1],'sources':[]}}", VEIL_ERR_INVALID,
+     "medium.sigma_a[0]", "expected a number in [0, 1e10] (m^-1: scene/limits.h), got 1e+20 (too large: at most 1e+10)"},
+    {"{" CAM ",'medium':{'sigma_s':[1,1,3e38],'sources':[]}}", VEIL_ERR_INVALID,
+     "medium.sigma_s[2]", "expected a number in [0, 1e10] (m^-1: scene/limits.h), got 3e+38 (too large: at most 1e+10)"},
+    {"{" CAM "," MED ",'background':{'color':[1e21,0,0]}}", VEIL_ERR_INVALID, "background.color[0]",
+     "expected a number in [0, 1e20] (scene/limits.h), got 1e+21 (too large: at most 1e+20)"},
+    {VDB("'density_scale':1e11"), VEIL_ERR_INVALID, "medium.sources[0].density_scale",
+     "expected a number in [0, 1e10] (scene/limits.h), got 1e+11 (too large: at most 1e+10)"},
+    {VDB("'emission':{'grid':'heat','scale':3e38}"), VEIL_ERR_INVALID, "medium.sources[0].emission.scale",
+     "expected a number in [0, 1e21] (scene/limits.h), got 3e+38 (too large: at most 1e+21)"},
+    {VDB("'emission':{'grid':'heat','color':[1,1e22,1]}"), VEIL_ERR_INVALID, "medium.sources[0].emission.color[1]",
+     "expected a number in [0, 1e21] (scene/limits.h), got 1e+22 (too large: at most 1e+21)"},
+    {VDB("'emission':{'grid':'heat','scale':1e20,'color':[1,100,1]}"), VEIL_ERR_INVALID,
+     "medium.sources[0].emission.scale", "scale x color[1] = 1e+20 x 100 = 1e+22 W m^-3 sr^-1 for a value of 1, "
+     "over the bound of 1e21 (scene/limits.h)"},
+    {VDB("'temperature':{'grid':'temperature','scale':3e38}"), VEIL_ERR_INVALID, "medium.sources[0].temperature.scale",
+     "expected a number in [-1e5, 1e5] (K: scene/limits.h), got 3e+38 (too large: at most 1e+05)"},
+    {VDB("'temperature':{'grid':'temperature','offset':-2e5}"), VEIL_ERR_INVALID,
+     "medium.sources[0].temperature.offset", "expected a number in [-1e5, 1e5] (K: scene/limits.h), got -200000"},
+    {VDB("'temperature':{'grid':'temperature','intensity':1e11}"), VEIL_ERR_INVALID,
+     "medium.sources[0].temperature.intensity",
+     "expected a number in [0, 1e10] (m^-1: scene/limits.h), got 1e+11 (too large: at most 1e+10)"},
+    {FOG("'density':1e11,'falloff':0"), VEIL_ERR_INVALID, "medium.sources[0].density",
+     "expected a number in [0, 1e10] (scene/limits.h), got 1e+11 (too large: at most 1e+10)"},
+    {FOG("'density':1,'falloff':3e38"), VEIL_ERR_INVALID, "medium.sources[0].falloff",
+     "expected a number in [0, 1e20] (m^-1: scene/limits.h), got 3e+38 (too large: at most 1e+20)"},
+    {SRC("{'type':'rbf','particles':[{'center':[0,0,0],'amplitude':3e38,'sharpness':1}]}"), VEIL_ERR_INVALID,
+     "medium.sources[0].particles[0].amplitude",
+     "expected a number in [0, 1e10] (scene/limits.h), got 3e+38 (too large: at most 1e+10)"},
+    {RND(RND_OK_COUNT RND_OK_BOUNDS "'radius':[1,1],'amplitude':[0,1e11]"), VEIL_ERR_INVALID,
+     "medium.sources[0].amplitude[1]", "expected a number in [0, 1e10] (scene/limits.h), got 1e+11 (too large: at most 1e+10)"},
     /* scene/limits.h (issue 12): what the float pipeline cannot carry is refused at load, by name */
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'rbf','particles':["
      "{'center':[3.4e38,0,0],'amplitude':1,'sharpness':1}]}]}}",
@@ -240,9 +342,9 @@ static const bad_case BAD[] = {
      "camera.up", "not parallel"},
     {"{" CAM ",'medium':{'sources':[]}}", VEIL_ERR_INVALID, "medium.sigma_s", "missing required field"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sigma_a':[0,-1,0],'sources':[]}}", VEIL_ERR_INVALID,
-     "medium.sigma_a[1]", "expected a number >= 0, got -1"},
+     "medium.sigma_a[1]", "expected a number in [0, 1e10] (m^-1: scene/limits.h), got -1"},
     {"{" CAM ",'medium':{'sigma_s':[1,1],'sources':[]}}", VEIL_ERR_INVALID, "medium.sigma_s",
-     "expected an array of 3 numbers >= 0, got an array of 2 elements"},
+     "expected an array of 3 numbers, each in [0, 1e10] (m^-1: scene/limits.h), got an array of 2 elements"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'max_resolution':-3,'sources':[]}}", VEIL_ERR_INVALID,
      "medium.max_resolution", "expected an integer in [2, 2048], got -3 (negative and zero values"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'max_resolution':4096,'sources':[]}}", VEIL_ERR_INVALID,
@@ -271,7 +373,7 @@ static const bad_case BAD[] = {
      VEIL_ERR_INVALID, "medium.sources[0].particles[0].center", "expected an array of 3 numbers"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'rbf','particles':["
      "{'center':[0,0,0],'amplitude':-1,'sharpness':1}]}]}}",
-     VEIL_ERR_INVALID, "medium.sources[0].particles[0].amplitude", "expected a number >= 0, got -1"},
+     VEIL_ERR_INVALID, "medium.sources[0].particles[0].amplitude", "expected a number in [0, 1e10] (scene/limits.h), got -1"},
     {RND("'count':1e8,'seed':1," RND_OK_BOUNDS "'radius':[1,1],'amplitude':[1,1]"), VEIL_ERR_INVALID,
      "medium.sources[0].count", "expected an integer in [0, 10000000]"},
     {RND("'count':3,'seed':-1," RND_OK_BOUNDS "'radius':[1,1],'amplitude':[1,1]"), VEIL_ERR_INVALID,
@@ -291,7 +393,7 @@ static const bad_case BAD[] = {
     {RND(RND_OK_COUNT RND_OK_BOUNDS "'radius':[1,1],'amplitude':[2,1]"), VEIL_ERR_INVALID,
      "medium.sources[0].amplitude", "0 <= c0 <= c1"},
     {RND(RND_OK_COUNT RND_OK_BOUNDS "'radius':[1,1]"), VEIL_ERR_INVALID,
-     "medium.sources[0].amplitude", "missing required field (an array of 2 numbers >= 0)"},
+     "medium.sources[0].amplitude", "missing required field (an array of 2 numbers, each in [0, 1e10] (scene/limits.h))"},
     {RND(RND_OK_COUNT RND_OK_BOUNDS "'radius':[1,1],'amplitude':[1,1],'particles':[]"), VEIL_ERR_INVALID,
      "medium.sources[0].particles", "unknown key"},
     {"{" CAM "," MED ",'lights':{}}", VEIL_ERR_INVALID, "lights", "expected an array, got an object"},
@@ -341,7 +443,7 @@ static const bad_case BAD[] = {
     {"{" CAM "," MED ",'background':{'colour':[1,1,1]}}", VEIL_ERR_INVALID, "background.colour",
      "unknown key (expected one of: color)"},
     {"{" CAM "," MED ",'background':{'color':[1,1,true]}}", VEIL_ERR_INVALID, "background.color[2]",
-     "expected a number >= 0, got true"},
+     "expected a number in [0, 1e20] (scene/limits.h), got true"},
     {"{" CAM "," MED ",'background':null}", VEIL_ERR_INVALID, "background", "expected an object, got null"},
 };
 
@@ -406,7 +508,7 @@ static void test_exact_messages(void)
     parse("demo.json", LIGHTS(LIGHT_OK "," LIGHT_OK ",{'type':'spot','position':[0,0,0]," SPOT_DI
           "'inner_angle_deg':45,'outer_angle_deg':30}"), &s, &e);
     CHECK(strcmp(e.msg, "demo.json: lights[2].inner_angle_deg: expected a number of degrees in "
-                        "[0, outer_angle_deg) = [0, 30), got 45") == 0, "%s", e.msg);
+                        "[0, outer_angle_deg) = [0, 30), got 45 (too large: below 30)") == 0, "%s", e.msg);
     parse("demo.json", SPOT(SPOT_DI "'inner_angle_deg':5"), &s, &e);
     CHECK(strcmp(e.msg, "demo.json: lights[0].outer_angle_deg: missing required field "
                         "(a number of degrees in (0, 180])") == 0, "%s", e.msg);
@@ -499,6 +601,8 @@ int main(void)
     test_defaults();
     test_multiple();
     test_bad();
+    test_bounds_accepted();
+    test_camera_up();
     test_spot();
     test_exact_messages();
     test_syntax();

@@ -39,6 +39,8 @@
 //   chunk_big.vdb, chunk_raw.vdb, chunk_header.vdb, root_count.vdb, no_offsets.vdb,
 //   half_mismatch.vdb, nano_size.nvdb, nano_child.nvdb: one small grid each,
 //                        with one claim of its tree made absurd (tree_files below)
+//   values.vdb           grids whose values the pipeline cannot carry (value_files below)
+//   values_nan.nvdb      its "density_nan" grid written by NanoVDB
 //
 // The values that tests/io/test_vdb.c recomputes (the linear field, the two
 // grids' voxel counts) are stated in the comments next to them.
@@ -58,6 +60,7 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -227,6 +230,44 @@ void sparse_pair()
 
 void tree_files(); // below: the tree files
 
+// A grid of the 8^3 index box [0, 7]^3, voxel 0.1 m, every voxel `fill`
+// but voxel (3, 3, 3), which is `odd`.
+FloatGrid::Ptr box_grid(const char* name, float fill, float odd)
+{
+    FloatGrid::Ptr g = float_grid(name, 0.1);
+    FloatGrid::Accessor acc = g->getAccessor();
+    for (int k = 0; k < 8; ++k)
+        for (int j = 0; j < 8; ++j)
+            for (int i = 0; i < 8; ++i) acc.setValue(Coord(i, j, k), i == 3 && j == 3 && k == 3 ? odd : fill);
+    return g;
+}
+
+// values.vdb: the grids of issue 22 (items 5 and 6) that the float
+// pipeline cannot carry, each beside good ones, all on the 8^3 box of
+// box_grid (tests/volume/test_grid_values.c, tests/cli/values_cli.sh):
+// "density" 1; "density_nan", "density_neg_inf", "density_big" (3e38) one
+// such voxel; "density_negative" -0.5 on the 64 voxels of i = 0;
+// "density_tile_nan" 1 and an active 8^3 tile of NaN beside it (512
+// voxels); "heat" 1, "heat_inf" and "heat_big" one +inf or 3e38 voxel,
+// "heat_negative" -1 everywhere; "temperature" 1500 (K), "temperature_big"
+// one 3e38 voxel, "temperature_inf" one +inf voxel.
+void value_files()
+{
+    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    FloatGrid::Ptr negative = box_grid("density_negative", 1.0f, 1.0f);
+    for (int k = 0; k < 8; ++k)
+        for (int j = 0; j < 8; ++j) negative->tree().setValue(Coord(0, j, k), -0.5f);
+    FloatGrid::Ptr tile = box_grid("density_tile_nan", 1.0f, 1.0f);
+    tile->tree().addTile(1, Coord(8, 0, 0), nan, true);
+    FloatGrid::Ptr density_nan = box_grid("density_nan", 1.0f, nan);
+    write("values.vdb", {box_grid("density", 1.0f, 1.0f), density_nan, box_grid("density_neg_inf", 1.0f, -inf),
+                         box_grid("density_big", 1.0f, 3e38f), negative, tile, box_grid("heat", 1.0f, 1.0f),
+                         box_grid("heat_inf", 1.0f, inf), box_grid("heat_big", 1.0f, 3e38f),
+                         box_grid("heat_negative", -1.0f, -1.0f), box_grid("temperature", 1500.0f, 1500.0f),
+                         box_grid("temperature_big", 1500.0f, 3e38f), box_grid("temperature_inf", 1500.0f, inf)});
+    nanovdb::io::writeGrid(path("values_nan.nvdb"), nanovdb::openToNanoVDB(*density_nan));
+}
+
 void make_all(bool big)
 {
     const float sphere_voxel = 0.05f, sphere_radius = 1.0f; // 20 voxels
@@ -319,6 +360,7 @@ void make_all(bool big)
     write("two_grids.vdb", {temp, dens}, false);
 
     sparse_pair();
+    value_files();
 
     write("smoke_plume.vdb", {plume(1.0)});
     if (big) write("big_plume.vdb", {plume(2.2)});

@@ -7,7 +7,13 @@
  *   radius sqrt(5/9 x 0.6) (3 / (4 pi))^(1/3) h (a ball of its volume);
  * - two emitting voxels apart make two lights, each at its voxel's centre
  *   with its own power (the k-d split never leaves a side empty);
- * - a grid without emission gives no light. */
+ * - a grid without emission gives no light;
+ * - intensities within VEIL_MAX_LIGHT (scene/limits.h, issue 22): a voxel
+ *   of 1e14 m emitting 1e21 W m^-3 sr^-1 (eps dV = 1e63, infinite as a
+ *   float), and an infinite eps dV among the points (the sparse path's
+ *   list), make finite lights of at most 1e20 W/sr, colour kept, at the
+ *   voxel's centre: they made an infinite light (a NaN position once
+ *   summed with another). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,6 +21,7 @@
 
 #include "support/check.h"
 #include "core/shared.glsl.h"
+#include "scene/limits.h"
 #include "volume/emission_lights.h"
 
 static float* grid_rgba(const veil_grid* g)
@@ -93,5 +100,35 @@ int main(void)
                   k, i, l[i].position[1]);
     }
     free(rgba);
+
+    /* issue 22: eps dV beyond a float, from a huge voxel or an infinite value */
+    veil_grid huge = {.dims = {4, 4, 4}, .origin = {-2e14f, -2e14f, -2e14f}, .voxel = 1e14f};
+    rgba = grid_rgba(&huge);
+    set(&huge, rgba, 1, 2, 3, 1e21f, 5e20f, 0.0f);
+    CHECK(veil_emission_lights(&huge, rgba, 1, l, &n, &err) == VEIL_OK && n == 1, "huge voxels: %d lights", n);
+    if (n == 1) {
+        veil_grid_center(&huge, 1, 2, 3, c);
+        CHECK(l[0].color[0] == (float)VEIL_MAX_LIGHT && fabsf(l[0].color[1] - 0.5f * (float)VEIL_MAX_LIGHT) <= 1e-6f * 1e20f &&
+                  l[0].color[2] == 0.0f, "huge voxel: intensity %g %g %g, expected 1e20, 5e19, 0 (its colour kept)",
+              l[0].color[0], l[0].color[1], l[0].color[2]);
+        for (int a = 0; a < 3; ++a)
+            CHECK(l[0].position[a] == c[a], "huge voxel: position[%d] %g, expected its centre %g", a, l[0].position[a], c[a]);
+        CHECK(isfinite(l[0].radius) && l[0].radius > 0.0f, "huge voxel: radius %g", l[0].radius);
+    }
+    /* with a dim voxel beside it: both saturate; finite, within the bound, inside the grid */
+    set(&huge, rgba, 3, 3, 3, 1.0f, 1.0f, 1.0f);
+    CHECK(veil_emission_lights(&huge, rgba, 1, l, &n, &err) == VEIL_OK && n == 1, "two huge voxels: %d lights", n);
+    for (int a = 0; n == 1 && a < 3; ++a)
+        CHECK(l[0].color[a] <= (float)VEIL_MAX_LIGHT && isfinite(l[0].position[a]) &&
+                  l[0].position[a] >= huge.origin[a] && l[0].position[a] <= huge.origin[a] + 4 * huge.voxel,
+              "two huge voxels: intensity[%d] %g, position %g", a, l[0].color[a], l[0].position[a]);
+    free(rgba);
+    const float pts[12] = {0.0f, 0.0f, 0.0f, INFINITY, 1.0f, 1.0f, 1.0f, 0.0f, 0.0f, 2.0f, 2.0f, 2.0f};
+    CHECK(veil_emission_lights_points(pts, 2, 1.0f, 1, l, &n, &err) == VEIL_OK && n == 1, "infinite point: %d lights", n);
+    if (n == 1) {
+        CHECK(l[0].color[0] <= (float)VEIL_MAX_LIGHT && isfinite(l[0].color[0]) && l[0].color[1] > 0.0f,
+              "an infinite eps dV: intensity %g %g %g, within 1e20", l[0].color[0], l[0].color[1], l[0].color[2]);
+        for (int a = 0; a < 3; ++a) CHECK(isfinite(l[0].position[a]), "infinite point: position[%d] %g", a, l[0].position[a]);
+    }
     return check_finish();
 }
