@@ -192,6 +192,17 @@ veil_result veil_sparse_work_check(veil_sparse_work* w, veil_error* err);
  * The atlas is at most max_side texels a side (GL_MAX_3D_TEXTURE_SIZE);
  * more bricks than it holds is VEIL_ERR_LIMIT with the numbers. */
 veil_result veil_sparse_build(const struct veil_scene_volume* v, int max_side, veil_sparse* out, veil_error* err);
+
+/* Internal to sparse.c and sparse_census.c: a brick's key in their hashes
+ * (21 bits an axis, bricks < 2^21 a side; 0 means empty), and the index offset of a VDB's
+ * voxels on the sparse grid of v (VEIL_ERR_INVALID when they are off it). */
+struct veil_vdb;
+static inline uint64_t veil__sparse_pack(const int b[3])
+{
+    return ((uint64_t)(uint32_t)b[0] | (uint64_t)(uint32_t)b[1] << 21 | (uint64_t)(uint32_t)b[2] << 42) + 1;
+}
+veil_result veil__sparse_offset_of(const struct veil_scene_volume* v, const struct veil_vdb* vdb, int off[3],
+                                   veil_error* err);
 void veil_sparse_free(veil_sparse* s); /* accepts a zeroed one */
 
 /* The atlas's texels per axis (9 atlas[a]). */
