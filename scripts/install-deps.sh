@@ -11,6 +11,7 @@ packages=(
   libcglm-dev libopenexr-dev libpng-dev libcjson-dev
   g++ libopenvdb-dev libboost-dev libtbb-dev                     # the OpenVDB reader (io/vdb.cpp)
   libnanovdb-dev                                                 # .nvdb files (headers only, io/vdb.cpp)
+  time                                                           # /usr/bin/time: tests bound a refusal's memory
 )
 
 missing=()
