@@ -17,6 +17,10 @@ vdb=$data/values.vdb
 tmp=$(mktemp -d /tmp/veil-values.XXXXXX)
 trap 'rm -rf "$tmp"' EXIT
 fails=0
+# the goal's 200 MB resident holds for veil as built; under AddressSanitizer its shadow memory and
+# quarantine add ~110 MB to every process, so there only the time and the message are checked
+asan=0
+ldd "$veil" 2>/dev/null | grep -q libasan && asan=1
 fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
 
 # scene NAME SOURCE_EXTRA MEDIUM_EXTRA ROOT_EXTRA: a 16x16 view of the 8^3 box
@@ -47,7 +51,7 @@ refused() {
   grep -qiE '\bnan\b|\binf\b' "$tmp/$1.err" && fail "$1: prints a C spelling of a value: $(head -c 400 "$tmp/$1.err")"
   [ -z "$(ls -A "$out")" ] || fail "$1: wrote $(ls -A "$out" | tr '\n' ' ')"
   awk -v s="$secs" 'BEGIN { exit !(s < 10) }' || fail "$1: took $secs s"
-  [ "${kb:-0}" -lt 204800 ] || fail "$1: $kb KB resident"
+  [ "$asan" = 1 ] || [ "${kb:-0}" -lt 204800 ] || fail "$1: $kb KB resident"
   echo "$1: exit $rc in $secs s, $kb KB: $(head -c 300 "$tmp/$1.err")"
 }
 
