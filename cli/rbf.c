@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "cli_util.h"
+#include "scene/limits.h"
 #include "commands.h"
 #include "io/particles.h"
 #include "scene/scene.h"
@@ -49,6 +50,9 @@ int veil_cmd_rbf(int argc, char** argv)
                 for (int a = 0; a < 3; ++a) ok = ok && v6[a] <= v6[a + 3];
                 if (!ok)
                     return veil_cli_usage_error("--bounds: expected x0,y0,z0,x1,y1,z1 (min and max corner, m) with min <= max, got '%s'", v);
+                for (int a = 0; a < 6; ++a) ok = ok && fabsf(v6[a]) <= (float)VEIL_MAX_COORD;
+                if (!ok) /* the particles' centres are refused beyond it (scene/limits.h): say so before any is made */
+                    return veil_cli_usage_error("--bounds: expected corners within [-1e15, 1e15] m (scene/limits.h), got '%s'", v);
                 memcpy(bounds, v6, sizeof bounds), have_b = 1;
             } else if (ok && !strcmp(s, "--radius")) {
                 if (!(v6[0] > 0 && v6[0] <= v6[1] && isfinite(1.0f / v6[0])))
@@ -57,6 +61,8 @@ int veil_cmd_rbf(int argc, char** argv)
             } else if (ok) {
                 if (!(v6[0] >= 0 && v6[0] <= v6[1]))
                     return veil_cli_usage_error("--amplitude: expected c0,c1 with 0 <= c0 <= c1, got '%s'", v);
+                if (!(v6[1] <= (float)VEIL_MAX_DENSITY))
+                    return veil_cli_usage_error("--amplitude: expected c1 <= 1e10 (a density: scene/limits.h), got '%s'", v);
                 memcpy(amp, v6, sizeof amp), have_a = 1;
             } else if (nlist == 6) {
                 return veil_cli_usage_error("--bounds: expected 6 comma-separated numbers x0,y0,z0,x1,y1,z1, got '%s'", v);

@@ -75,6 +75,9 @@ options)
     check "--radius: expected r0,r1" -o x.bin --count 1 --seed 1 --bounds 0,0,0,1,1,1 --radius 0.3,0.2 --amplitude 1,1
     check "--amplitude: expected c0,c1" -o x.bin --count 1 --seed 1 --bounds 0,0,0,1,1,1 --radius 0.1,0.2 --amplitude -1,1
     check "--amplitude: expected 2" -o x.bin --count 1 --seed 1 --bounds 0,0,0,1,1,1 --radius 0.1,0.2 --amplitude 1
+    # beyond what a particle file may hold (scene/limits.h): usage errors up front, not a failed write (issue 22)
+    check "--amplitude: expected c1 <= 1e10" -o x.bin --count 1 --seed 1 --bounds 0,0,0,1,1,1 --radius 0.1,0.2 --amplitude 0,3e38
+    check "--bounds: expected corners within" -o x.bin --count 1 --seed 1 --bounds 0,0,0,1e20,1,1 --radius 0.1,0.2 --amplitude 1,1
     # shellcheck disable=SC2086
     check "--noise-amount: expected" $ok --noise-amount 1.5
     check "--noise-scale: expected" $ok --noise-scale 0
