@@ -193,12 +193,10 @@ int veil_cmd_fog(int argc, char** argv)
                 (first_negative / 4) % (size_t)w, (first_negative / 4) / (size_t)w, "RGB"[first_negative % 4]);
     if (r == VEIL_OK) r = read_depth(&a, w, h, &depth, &channel, &err);
     if (r == VEIL_OK) r = to_distance(&a, &scene.camera, w, h, channel, depth, &err);
-    veil_gl* gl = NULL;
     veil_renderer* ren = NULL;
     veil_image_set im = {0};
     veil_render_stats st = {0};
-    if (r == VEIL_OK) r = veil_gl_create(NULL, &gl, &err);
-    if (r == VEIL_OK) r = veil_renderer_create(gl, &ren, &err);
+    if (r == VEIL_OK) r = veil_renderer_create_deferred(NULL, &ren, &err);
     if (r == VEIL_OK) {
         veil_render_opts opts = {.behind = frame, .behind_distance = depth};
         veil_cli_progress_begin(NULL);
@@ -212,7 +210,6 @@ int veil_cmd_fog(int argc, char** argv)
                              a.png ? a.png : "", channel, a.depth_is_distance ? "distance along the ray" : "Z");
     veil_image_set_free(&im);
     veil_renderer_destroy(ren);
-    veil_gl_destroy(gl);
     veil_scene_free(&scene);
     free(frame);
     free(depth);

@@ -139,10 +139,9 @@ int veil_cmd_render(int argc, char** argv)
         return rc;
     }
 
-    veil_gl* gl = NULL;
     veil_renderer* ren = NULL;
-    r = veil_gl_create(NULL, &gl, &err);
-    if (r == VEIL_OK) r = veil_renderer_create(gl, &ren, &err);
+    /* its GL context is made once the sources are open and their work estimated: a refusal costs none */
+    r = veil_renderer_create_deferred(NULL, &ren, &err);
     long frames = a.frames > 0 ? a.frames : 1;
     veil_image_set im = {0};
     for (long f = 0; f < frames && r == VEIL_OK; ++f) {
@@ -174,7 +173,6 @@ int veil_cmd_render(int argc, char** argv)
     }
     veil_image_set_free(&im);
     veil_renderer_destroy(ren);
-    veil_gl_destroy(gl);
     veil_scene_free(&scene);
     veil_cli_folders_done(&made, r == VEIL_OK); /* failed: the folders it made for nothing go */
     return r == VEIL_OK ? EXIT_OK : veil_cli_fail(r, &err);

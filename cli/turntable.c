@@ -298,7 +298,6 @@ int veil_cmd_turntable(int argc, char** argv)
     }
     double t_start = veil_now_ms();
     const uint64_t scene_hash = file_hash(a.scene);
-    veil_gl* gl = NULL;
     veil_renderer* ren = NULL;
     veil_image_set im = {0};
     long done = 0, skipped = 0, missing = 0;
@@ -326,9 +325,9 @@ int veil_cmd_turntable(int argc, char** argv)
             veil_cli_prefix_error(&err, a.scene);
             break;
         }
-        if (!gl) { /* made on the first frame to render: a rerun with every frame done needs no GPU */
-            r = veil_gl_create(NULL, &gl, &err);
-            if (r == VEIL_OK) r = veil_renderer_create(gl, &ren, &err);
+        if (!ren) { /* made on the first frame to render: a rerun with every frame done needs no GPU, and its
+                     * GL context once that frame's sources are open and their work estimated */
+            r = veil_renderer_create_deferred(NULL, &ren, &err);
             if (r != VEIL_OK) break;
             t_render = veil_now_ms();
         }
@@ -397,7 +396,6 @@ int veil_cmd_turntable(int argc, char** argv)
     }
     veil_image_set_free(&im);
     veil_renderer_destroy(ren);
-    veil_gl_destroy(gl);
     veil_scene_free(&scene);
     veil_cli_folders_done(&made, r == VEIL_OK); /* failed: the folders it made for nothing go */
     return r == VEIL_OK ? EXIT_OK : veil_cli_fail(r, &err);

@@ -14,15 +14,16 @@
 struct veil_renderer {
     unsigned long long memory_budget; /* bytes, see veil_gl_info */
     veil_frame_parts parts;           /* the stages' GPU objects and the keys of what they hold */
+    int ready;                        /* 1: the GL context and the stages' objects are made */
+    veil_gl* own_gl;                  /* a deferred renderer's context, made by it and destroyed with it */
+    veil_gl_desc gl_desc;             /* what to make it with */
 };
 
 /* ---- lifetime ---------------------------------------------------------- */
 
-veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_error* err)
+/* The stages' GPU objects, on the current context gl. */
+static veil_result make_parts(veil_renderer* r, const veil_gl* gl, veil_error* err)
 {
-    *out = NULL;
-    veil_renderer* r = calloc(1, sizeof *r);
-    if (!r) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the renderer");
     r->memory_budget = veil_gl_get_info(gl)->memory_budget;
     veil_frame_parts* p = &r->parts;
     veil_result res = veil_ev_create(&p->ev, err);
@@ -30,11 +31,42 @@ veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_er
     if (res == VEIL_OK) res = veil_volumetric_create(&p->volumetric, err);
     if (res == VEIL_OK) res = veil_march_create(&p->march, err);
     if (res == VEIL_OK) res = veil_spread_create(&p->spread, err);
+    r->ready = res == VEIL_OK;
+    return res;
+}
+
+veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_error* err)
+{
+    *out = NULL;
+    veil_renderer* r = calloc(1, sizeof *r);
+    if (!r) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the renderer");
+    veil_result res = make_parts(r, gl, err);
     if (res != VEIL_OK) {
         veil_renderer_destroy(r);
         return res;
     }
     *out = r;
+    return VEIL_OK;
+}
+
+veil_result veil_renderer_create_deferred(const veil_gl_desc* desc, veil_renderer** out, veil_error* err)
+{
+    *out = calloc(1, sizeof **out);
+    if (!*out) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the renderer");
+    if (desc) (*out)->gl_desc = *desc;
+    return VEIL_OK;
+}
+
+/* The frame's hook (veil_frame.gpu): a deferred renderer's context and objects, once. */
+static veil_result make_gpu(veil_frame* f, veil_error* err)
+{
+    veil_renderer* r = f->gpu_user;
+    if (!r->ready) {
+        veil_result res = r->own_gl ? VEIL_OK : veil_gl_create(&r->gl_desc, &r->own_gl, err);
+        if (res == VEIL_OK) res = make_parts(r, r->own_gl, err);
+        if (res != VEIL_OK) return res;
+    }
+    f->plan.budget = r->memory_budget;
     return VEIL_OK;
 }
 
@@ -46,6 +78,7 @@ void veil_renderer_destroy(veil_renderer* r)
     veil_volumetric_destroy(r->parts.volumetric);
     veil_march_destroy(r->parts.march);
     veil_spread_destroy(r->parts.spread);
+    veil_gl_destroy(r->own_gl);
     free(r);
 }
 
@@ -62,6 +95,8 @@ static veil_result run_frame(veil_renderer* r, veil_frame* f, veil_render_stats*
                          VEIL_MAX_LIGHTS);
     f->parts = &r->parts;
     f->st = st;
+    f->gpu = make_gpu;
+    f->gpu_user = r;
     veil_result res = VEIL_OK;
     for (int i = 0; i < VEIL_STAGE_COUNT && res == VEIL_OK; ++i) {
         const veil_stage_row* row = &veil_stage_table[i];
@@ -71,9 +106,11 @@ static veil_result run_frame(veil_renderer* r, veil_frame* f, veil_render_stats*
         rep->key = row->key(&f->plan);
         int kept = !row->per_view && r->parts.has[row->id] && r->parts.kept[row->id] == rep->key;
         rep->status = row->decide(&f->plan, kept, rep->why, sizeof rep->why);
-        if (rep->status == VEIL_STAGE_RAN) res = row->build(f, rep, err);
+        /* inject makes the GPU's side itself, once its sources are open and their work estimated */
+        if (rep->status == VEIL_STAGE_RAN && row->id != VEIL_STAGE_INJECT) res = make_gpu(f, err);
+        if (res == VEIL_OK && rep->status == VEIL_STAGE_RAN) res = row->build(f, rep, err);
         if (res == VEIL_OK && row->settle) row->settle(f, rep);
-        glFinish();
+        if (r->ready) glFinish();
         rep->ms = veil_now_ms() - t0;
     }
     st->inject_ms = st->stage[VEIL_STAGE_INJECT].ms;
@@ -89,7 +126,7 @@ veil_result veil_render_scene_images(veil_renderer* r, const veil_scene* s, cons
     memset(&st, 0, sizeof st);
     veil_image_set_free(images);
     veil_frame f = {.images = images};
-    veil_frame_plan_begin(&f.plan, s, opts, r->memory_budget);
+    veil_frame_plan_begin(&f.plan, s, opts, r->memory_budget); /* 0 until a deferred renderer's GPU is made */
     veil_result res = run_frame(r, &f, &st, err);
     if (stats) *stats = st;
     return res;

@@ -33,6 +33,11 @@
 typedef struct veil_renderer veil_renderer;
 
 veil_result veil_renderer_create(const veil_gl* gl, veil_renderer** out, veil_error* err);
+/* A renderer that makes its own GL context (desc may be NULL) when a frame
+ * first needs the GPU: after inject has opened the sources and estimated
+ * their work, so that a volume refused on the CPU never costs a context
+ * (the CLI's; VEIL_ERR_GPU then comes from the first render). */
+veil_result veil_renderer_create_deferred(const veil_gl_desc* desc, veil_renderer** out, veil_error* err);
 void veil_renderer_destroy(veil_renderer* r); /* accepts NULL */
 
 /* The whole pipeline for a scene, into an image set (*images is freed

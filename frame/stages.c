@@ -236,9 +236,11 @@ static veil_lit_medium lit_medium(const veil_frame* f)
 /* The EV changed (or is gone): nothing made from it is valid any more. */
 static void forget_volume(veil_frame_parts* parts)
 {
-    veil_ev_clear(parts->ev);
-    veil_opv_set_clear(parts->opv);
-    veil_volumetric_clear(parts->volumetric);
+    if (parts->ev) { /* (a deferred renderer's GPU side may not be made yet: nothing is held then) */
+        veil_ev_clear(parts->ev);
+        veil_opv_set_clear(parts->opv);
+        veil_volumetric_clear(parts->volumetric);
+    }
     for (int i = VEIL_STAGE_INJECT; i <= VEIL_STAGE_VOLUMETRIC; ++i) parts->has[i] = 0, parts->kept[i] = 0;
     parts->particles = 0;
     parts->opv_textures = 0;
@@ -302,19 +304,28 @@ static veil_result inject_build(veil_frame* f, veil_stage_report* rep, veil_erro
     veil_frame_parts* r = f->parts;
     const veil_frame_plan* p = &f->plan;
     const int had = r->has[VEIL_STAGE_INJECT];
-    forget_volume(r);
+    veil_result res = VEIL_OK;
     if (p->given_grid) {
-        veil_result res = veil_ev_build_density(r->ev, p->given_grid, p->given_density, (int)p->scene->light_count,
-                                                p->budget, err);
+        if (f->gpu) res = f->gpu(f, err);
+        forget_volume(r);
+        if (res != VEIL_OK) return res;
+        res = veil_ev_build_density(r->ev, p->given_grid, p->given_density, (int)p->scene->light_count,
+                                    p->budget, err);
         if (res == VEIL_OK) r->has[VEIL_STAGE_INJECT] = 1, r->kept[VEIL_STAGE_INJECT] = rep->key;
         return res;
     }
     veil_scene_volume v;
-    veil_result res = veil_scene_volume_open(p->scene, &v, err);
-    if (res != VEIL_OK) return res;
+    res = veil_scene_volume_open(p->scene, &v, err);
     /* a sparse volume's work, before the gather (and the GPU's work) starts */
     veil_sparse_work work;
-    res = veil_frame_sparse_estimate(p, &v, &work, err);
+    if (res == VEIL_OK) res = veil_frame_sparse_estimate(p, &v, &work, err);
+    /* only now the GPU, when it waited: a refused volume never made a GL context (issue 22: 57 MB) */
+    if (res == VEIL_OK && f->gpu) res = f->gpu(f, err);
+    forget_volume(r); /* whatever happens next, the volume held is not this one */
+    if (res != VEIL_OK) {
+        veil_scene_volume_close(&v); /* (a failed open left it empty: closing it is a no-op) */
+        return res;
+    }
     veil_ev_report er = {0};
     if (res == VEIL_OK) res = veil_ev_build_scene(r->ev, &v, (int)p->scene->light_count, p->budget, &er, err);
     if (res == VEIL_OK) {
@@ -357,10 +368,11 @@ static void inject_settle(veil_frame* f, const veil_stage_report* rep)
         forget_volume(r); /* decided: no voxelised source, an empty medium remembered as such */
         r->has[VEIL_STAGE_INJECT] = 1, r->kept[VEIL_STAGE_INJECT] = rep->key;
     }
-    const veil_grid* g = veil_ev_grid(r->ev);
+    /* (no EV before a deferred renderer's GPU side is made: a skipped inject made none) */
+    const veil_grid* g = r->ev ? veil_ev_grid(r->ev) : NULL;
     int emitting = 0;
-    const veil_light* el = veil_ev_emission_lights(r->ev, &emitting);
-    veil_frame_plan_volume(p, g, veil_ev_sparse_of(r->ev) != NULL, el, emitting);
+    const veil_light* el = r->ev ? veil_ev_emission_lights(r->ev, &emitting) : NULL;
+    veil_frame_plan_volume(p, g, r->ev && veil_ev_sparse_of(r->ev) != NULL, el, emitting);
     veil_render_stats* st = f->st;
     st->inject_cached = rep->status == VEIL_STAGE_CACHED;
     st->emission_lights = p->emission_lights;

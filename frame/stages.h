@@ -177,6 +177,11 @@ typedef struct veil_frame {
     veil_render_stats* st;           /* a render's report (NULL when explaining) */
     veil_image_set* images;          /* the march's output */
     veil_volumetric_field field;     /* the volumetric stage's field for the march */
+    /* Makes the GPU's side (a renderer whose GL context is deferred: its context and stages' objects, and
+     * plan.budget) if it is not made yet; inject calls it once the sources are opened and their work
+     * estimated, so that a refused volume never costs a GL context. NULL: always made. */
+    veil_result (*gpu)(struct veil_frame* f, veil_error* err);
+    void* gpu_user;
 } veil_frame;
 
 /* A row of the table. decide() and key() read only the plan and never a
