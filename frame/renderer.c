@@ -62,8 +62,10 @@ static veil_result make_gpu(veil_frame* f, veil_error* err)
 {
     veil_renderer* r = f->gpu_user;
     if (!r->ready) {
+        const double t0 = veil_now_ms();
         veil_result res = r->own_gl ? VEIL_OK : veil_gl_create(&r->gl_desc, &r->own_gl, err);
         if (res == VEIL_OK) res = make_parts(r, r->own_gl, err);
+        f->gpu_ms += veil_now_ms() - t0;
         if (res != VEIL_OK) return res;
     }
     f->plan.budget = r->memory_budget;
@@ -101,7 +103,7 @@ static veil_result run_frame(veil_renderer* r, veil_frame* f, veil_render_stats*
     for (int i = 0; i < VEIL_STAGE_COUNT && res == VEIL_OK; ++i) {
         const veil_stage_row* row = &veil_stage_table[i];
         veil_stage_report* rep = &st->stage[row->id];
-        double t0 = veil_now_ms();
+        double t0 = veil_now_ms(), gpu0 = f->gpu_ms;
         veil_progress(row->doing, 0, 1);
         rep->key = row->key(&f->plan);
         int kept = !row->per_view && r->parts.has[row->id] && r->parts.kept[row->id] == rep->key;
@@ -111,7 +113,7 @@ static veil_result run_frame(veil_renderer* r, veil_frame* f, veil_render_stats*
         if (res == VEIL_OK && rep->status == VEIL_STAGE_RAN) res = row->build(f, rep, err);
         if (res == VEIL_OK && row->settle) row->settle(f, rep);
         if (r->ready) glFinish();
-        rep->ms = veil_now_ms() - t0;
+        rep->ms = veil_now_ms() - t0 - (f->gpu_ms - gpu0);
     }
     st->inject_ms = st->stage[VEIL_STAGE_INJECT].ms;
     st->propagate_ms = st->stage[VEIL_STAGE_PROPAGATE].ms;

@@ -182,6 +182,7 @@ typedef struct veil_frame {
      * estimated, so that a refused volume never costs a GL context. NULL: always made. */
     veil_result (*gpu)(struct veil_frame* f, veil_error* err);
     void* gpu_user;
+    double gpu_ms; /* the time gpu() spent making the GPU's side: no stage's work, so no stage's time */
 } veil_frame;
 
 /* A row of the table. decide() and key() read only the plan and never a
