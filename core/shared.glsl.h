@@ -176,7 +176,7 @@ VEIL_STRUCT_BEGIN(veil_march_block)
     VEIL_UV4(flags);       /* x: -, y: skip empty bricks, z: jitter seed, w: per-pixel end */
     VEIL_V4(octave);       /* volumetric multiple scattering: x: a, y: b, z: c, w: octaves (0: off) */
     VEIL_V4(diffusion);    /* xyz: the volumetric field's texture origin (m); w: its veil_field_kind */
-    VEIL_V4(diffusion_inv); /* xyz: texture coordinates per m */
+    VEIL_V4(diffusion_inv); /* xyz: texture coordinates per m; w: the light cache's nz (its grid's cells along z) */
 VEIL_STRUCT_END(veil_march_block)
 
 /* ---- the sparse extinction volume (volume/sparse.h) --------------------- */
@@ -308,8 +308,14 @@ VEIL_FN float veil_spread_level(float w, float c, float K)
 #define VEIL_FIELD_NONE 0
 #define VEIL_FIELD_FLUENCE 1
 #define VEIL_FIELD_ESCAPE 2
+#define VEIL_FIELD_CACHE 3
 #else
-typedef enum veil_field_kind { VEIL_FIELD_NONE = 0, VEIL_FIELD_FLUENCE = 1, VEIL_FIELD_ESCAPE = 2 } veil_field_kind;
+typedef enum veil_field_kind {
+    VEIL_FIELD_NONE = 0,
+    VEIL_FIELD_FLUENCE = 1,
+    VEIL_FIELD_ESCAPE = 2,
+    VEIL_FIELD_CACHE = 3 /* the light cache: fluence rgb of light scattered at least once, and its flux */
+} veil_field_kind;
 #endif
 
 VEIL_STRUCT_BEGIN(veil_diffusion_block)
@@ -319,6 +325,79 @@ VEIL_STRUCT_BEGIN(veil_diffusion_block)
     VEIL_IV4(dims);      /* xyz: cells; w: the parity updated (red-black) */
     VEIL_V4(relax);      /* x: over-relaxation omega */
 VEIL_STRUCT_END(veil_diffusion_block)
+
+/* ---- the light cache (volumetric/cache.h) ------------------------------ */
+
+/* Photons traced from the lights through the medium by delta tracking
+ * against a per-cell majorant; after their first scattering (from their
+ * start for the medium's own emission) every piece of path in a cell adds
+ * w len / V to the cell's fluence (the track-length estimator) and
+ * lum(w) len omega / V to its flux. Sums are signed 64-bit fixed point (two
+ * uint words, low first) added with integer atomics: order-free, so a seed
+ * gives the same cache bit for bit. */
+#define VEIL_CACHE_GROUP 64        /* photons per work group */
+#define VEIL_CACHE_CELL_GROUP 4    /* 4^3 cells per work group (bounds, resolve) */
+#define VEIL_CACHE_SUMS 7          /* per cell: fluence r, g, b; flux x, y, z; the odd photons' luminance fluence */
+#define VEIL_CACHE_WORDS (2 * VEIL_CACHE_SUMS)
+/* A score is at most 2^VEIL_CACHE_FIXED_BITS units (volumetric/cache.c
+ * derives the unit from the largest score a photon can make), so one add
+ * fits an int32 and 2^33 of them fit a cell's 64 bits. */
+#define VEIL_CACHE_FIXED_BITS 30
+/* SSBO bindings of the cache's own passes (GL guarantees 8: 0..7) */
+#define VEIL_BIND_CACHE_SUM 0      /* uint[cells * VEIL_CACHE_WORDS] */
+#define VEIL_BIND_CACHE_CELL 1     /* vec2[cells]: majorant density, emission weight */
+#define VEIL_BIND_CACHE_EMIT 2     /* the emitting cells: uvec2 (cell, the CDF up to it as float bits) */
+#define VEIL_BIND_CACHE_COUNT 3    /* uint[4]: photons cut at the step cap, scores clamped, -, - */
+#define VEIL_UBO_CACHE 7
+/* The cache is one rgba32f texture of two stacked grids (cells nx, ny, 2 nz): z in [0, nz) the fluence rgb
+ * with the odd photons' luminance fluence in a, z in [nz, 2 nz) the luminance-weighted flux xyz. One
+ * sampler reads both (the march clamps z within a half, so filtering never crosses): on Mesa 22's
+ * llvmpipe a second 3D sampler read with texture() in the march returned 0 on all but the first
+ * invocation of each row of a work group (texelFetch did not). */
+#define VEIL_IMAGE_CACHE 0         /* image unit: the cache, written by the resolve pass */
+/* The photons' work (steps: a piece of path in a cell, or a tentative
+ * collision). volumetric/cache.c estimates the steps a photon takes from
+ * the cells' majorants; the photons of a cache take at most
+ * VEIL_CACHE_STEPS_PER_PHOTON times the budget's photons in all (fewer
+ * photons where the medium is thick, never under VEIL_CACHE_MIN_PHOTONS;
+ * thicker than that, no cache), and each photon is cut at 8 times the
+ * estimate, within [VEIL_CACHE_MIN_CUT, VEIL_CACHE_MAX_CUT] (counted). */
+#define VEIL_CACHE_STEPS_PER_PHOTON 512
+#define VEIL_CACHE_MIN_PHOTONS 4096
+#define VEIL_CACHE_MIN_CUT 4096
+#define VEIL_CACHE_MAX_CUT 65536
+/* Source kinds of a dispatch (veil_cache_block.source.x). */
+#define VEIL_CACHE_SUN 0
+#define VEIL_CACHE_CONE 1          /* point and spot lights: directions in a cone */
+#define VEIL_CACHE_EMISSION 2      /* the medium's emission, by cell */
+
+VEIL_STRUCT_BEGIN(veil_cache_block)
+    VEIL_V4(origin);   /* xyz: the grid's min corner (m); w: cell edge h (m) */
+    VEIL_IV4(dims);    /* xyz: cells; w: emitting cells (VEIL_CACHE_EMISSION) */
+    VEIL_V4(sigma_a);  /* rgb: m^-1 per unit density; w: the majorant's floor (m^-1) where a cell has density */
+    VEIL_V4(sigma_s);  /* rgb: m^-1 per unit density; w: HG g */
+    VEIL_V4(scale);    /* x: units per score (W/m^2)^-1, y: W/m^2 per unit, z: 1 / V (m^-3), w: max sigma_t per density */
+    VEIL_UV4(source);  /* x: VEIL_CACHE_*, y: the light, z: the first photon of this dispatch, w: photons of the source */
+    VEIL_UV4(seed);    /* x: the seed, y: the source's index among the cache's, z: a photon's step cap, w: - */
+    VEIL_V4(power);    /* rgb: W per photon (sun, cone: before a spot's falloff; emission: W per photon per
+                          (W m^-3 sr^-1 of emission, 1 / p of the cell)), w: - */
+    VEIL_V4(src0);     /* sun: a corner of the rectangle photons start on; cone: the apex (m) */
+    VEIL_V4(src1);     /* sun: the rectangle's first edge (m); cone: the axis (unit), w: cos of the half-angle */
+    VEIL_V4(src2);     /* sun: the second edge (m); w: - */
+    VEIL_V4(src3);     /* sun: the travel direction (unit) */
+VEIL_STRUCT_END(veil_cache_block)
+
+/* The fixed point: a score s >= 0 (or a signed flux component) is added as
+ * the integer floor(s * units + xi), xi uniform in [0, 1): unbiased
+ * (E = s * units exactly, for any s), off by less than one unit, and
+ * clamped to +-(2^31 - 128), the largest float below 2^31 (a score over 2^VEIL_CACHE_FIXED_BITS units is
+ * outside the bound the unit was derived from: counted, never wrapped). */
+VEIL_FN int veil_cache_fixed(float s_units, float xi)
+{
+    float v = VEIL_FLOORF(s_units + xi);
+    v = VEIL_MINF(VEIL_MAXF(v, -2147483520.0), 2147483520.0);
+    return VEIL_INT(v);
+}
 
 /* Henyey–Greenstein phase function (sr^-1), cos_theta the cosine between the
  * light's travel direction and the scattered direction; g = 0 is isotropic

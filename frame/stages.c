@@ -22,10 +22,10 @@
  * each rung slower and more accurate than the one below it on the shared
  * smoke, none dominated on the three scenes of bench/peers.py. */
 static const veil_quality_rung rungs[VEIL_QUALITY_COUNT] = {
-    [VEIL_QUALITY_DRAFT] = {1.0f, VEIL_OPV_LIGHT_SPACE, 1.0f, 4.0f},
-    [VEIL_QUALITY_DEFAULT] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.5f, 4.0f},
-    [VEIL_QUALITY_HIGH] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.35f, 4.0f},
-    [VEIL_QUALITY_MAX] = {0.25f, VEIL_OPV_LIGHT_SPACE, 0.25f, 4.0f},
+    [VEIL_QUALITY_DRAFT] = {1.0f, VEIL_OPV_LIGHT_SPACE, 1.0f, 4.0f, 1LL << 16, 24},
+    [VEIL_QUALITY_DEFAULT] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.5f, 4.0f, 1LL << 18, 40},
+    [VEIL_QUALITY_HIGH] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.35f, 4.0f, 1LL << 20, 64},
+    [VEIL_QUALITY_MAX] = {0.25f, VEIL_OPV_LIGHT_SPACE, 0.25f, 4.0f, 1LL << 22, 96},
 };
 
 const veil_quality_rung* veil_quality_rung_of(veil_quality q)
@@ -123,6 +123,7 @@ void veil_frame_plan_begin(veil_frame_plan* p, const veil_scene* s, const veil_r
  * diffusion fluence when that is the method, else nothing. */
 static veil_field_kind field_kind(const veil_multiple* m)
 {
+    if (m->volumetric && m->volumetric_method == VEIL_VOLUMETRIC_CACHE) return VEIL_FIELD_CACHE;
     int escape = m->volumetric_method == VEIL_VOLUMETRIC_OCTAVE && m->octave_gate == VEIL_GATE_ESCAPE;
     if (!m->volumetric || (m->volumetric_method == VEIL_VOLUMETRIC_OCTAVE && !escape) || m->octaves < 2 * escape)
         return VEIL_FIELD_NONE;
@@ -135,6 +136,15 @@ void veil_frame_plan_volume(veil_frame_plan* p, const veil_grid* g, int sparse, 
     p->grid = g;
     p->sparse = g ? sparse : 0;
     p->light_count = veil_render_lights(p->scene, g, p->lights);
+    const veil_multiple* m = &p->scene->multiple;
+    /* the light cache carries all of the emission's light (volume/cache.h): it needs no emission lights */
+    const int cache = field_kind(m) == VEIL_FIELD_CACHE;
+    p->glows = 0;
+    for (size_t i = 0; g && i < p->scene->medium.source_count; ++i) {
+        const veil_source* src = &p->scene->medium.sources[i];
+        p->glows |= src->type == VEIL_SOURCE_VDB && (src->vdb.emission_grid || src->vdb.temperature_grid);
+    }
+    if (cache) n_emission = 0;
     /* the medium's emission as lights (volume/emission_lights.h): after the scene's, while there is room */
     if (n_emission > VEIL_MAX_LIGHTS - p->light_count) n_emission = VEIL_MAX_LIGHTS - p->light_count;
     for (int i = 0; i < n_emission; ++i) p->lights[p->light_count++] = emission[i];
@@ -145,13 +155,17 @@ void veil_frame_plan_volume(veil_frame_plan* p, const veil_grid* g, int sparse, 
                                           p->sparse ? 0 : VEIL_GL_MIN_3D_TEXTURE, p->index_lights, p->suns,
                                           p->sun_keys)
                      : 0;
-    const veil_multiple* m = &p->scene->multiple;
+    const veil_quality_rung* q = veil_quality_rung_of(p->o.quality);
     p->volumetric = (veil_volumetric_desc){
         .kind = field_kind(m),
         .medium = {.scene = p->scene, .lights = p->lights, .light_count = p->light_count, .grid = g,
                    .sparse = NULL},
         .diffusion_cells = m->diffusion_cells,
-        .diffusion_iterations = m->diffusion_iterations};
+        .diffusion_iterations = m->diffusion_iterations,
+        .cache = {.photons = m->cache_photons > 0 ? m->cache_photons : q->cache_photons,
+                  .cells = m->cache_cells > 0 ? m->cache_cells : q->cache_cells,
+                  .seed = m->cache_seed,
+                  .emission = cache && p->glows}};
 }
 
 veil_result veil_frame_sparse_estimate(const veil_frame_plan* p, const veil_scene_volume* v, veil_sparse_work* w,
@@ -489,9 +503,15 @@ static void propagate_settle(veil_frame* f, const veil_stage_report* rep)
 
 /* ---- volumetric: multiply scattered light, view-independent ----------- */
 
+/* Sources of the volumetric field: the lights, and for the light cache the medium's emission. */
+static int volumetric_sources(const veil_frame_plan* p)
+{
+    return p->light_count + (p->volumetric.kind == VEIL_FIELD_CACHE && p->volumetric.cache.emission);
+}
+
 static uint64_t volumetric_key(const veil_frame_plan* p)
 {
-    if (p->volumetric.kind == VEIL_FIELD_NONE || p->light_count == 0) return 0;
+    if (p->volumetric.kind == VEIL_FIELD_NONE || volumetric_sources(p) == 0) return 0;
     return veil_volumetric_key(p->ev_key, &p->volumetric);
 }
 
@@ -505,11 +525,12 @@ static veil_stage_status volumetric_decide(const veil_frame_plan* p, int kept, c
                                       : "no volumetric estimate (multiple_scattering.volumetric)");
         return VEIL_STAGE_SKIPPED;
     }
-    if (p->light_count == 0) {
-        say(w, n, "no light reaches the medium");
+    const int cache = d->kind == VEIL_FIELD_CACHE;
+    if (volumetric_sources(p) == 0) {
+        say(w, n, "no light reaches the medium%s", cache ? " and it does not glow" : "");
         return VEIL_STAGE_SKIPPED;
     }
-    if (p->sparse && !escape) {
+    if (p->sparse && !escape && !cache) {
         say(w, n, "the diffusion solve needs a dense grid; over a sparse volume there is no volumetric estimate "
                   "(set multiple_scattering.volumetric_method to \"octave\")");
         return VEIL_STAGE_SKIPPED;
@@ -518,7 +539,7 @@ static veil_stage_status volumetric_decide(const veil_frame_plan* p, int kept, c
     dd.medium.sparse = NULL;
     float lo[3], cell;
     int dims[3];
-    if (!(p->sparse ? p->grid != NULL : veil_volumetric_grid(&dd, lo, &cell, dims) != 0)) {
+    if (!(p->sparse && !cache ? p->grid != NULL : veil_volumetric_grid(&dd, lo, &cell, dims) != 0)) {
         say(w, n, "no grid: no medium, or a fog box over %g m%s", VEIL_DIFFUSION_MAX_EXTENT,
             escape ? " (the octaves fall back to the legs gate)" : "");
         return VEIL_STAGE_SKIPPED;
@@ -532,6 +553,11 @@ static veil_stage_status volumetric_decide(const veil_frame_plan* p, int kept, c
         say(w, n, "key %016llx: the octaves' escape field, %d points a kept brick (every %.4g m): view- and "
             "light-independent, kept", key, VEIL_SPARSE_ESCAPE * VEIL_SPARSE_ESCAPE * VEIL_SPARSE_ESCAPE,
             (double)VEIL_BRICK / (VEIL_SPARSE_ESCAPE - 1) * p->grid->voxel);
+    else if (cache)
+        say(w, n, "key %016llx: the light cache, %lld photons from %d source%s%s, %dx%dx%d cells of %.4g m: "
+            "view-independent, kept for the next frames", key, d->cache.photons, volumetric_sources(p),
+            volumetric_sources(p) == 1 ? "" : "s", d->cache.emission ? " (the emission one of them)" : "",
+            dims[0], dims[1], dims[2], cell);
     else if (escape)
         say(w, n, "key %016llx: the octaves' escape field, %dx%dx%d cells of %.4g m: view- and light-independent, "
             "kept", key, dims[0], dims[1], dims[2], cell);
@@ -553,9 +579,32 @@ static veil_result volumetric_build(veil_frame* f, veil_stage_report* rep, veil_
     veil_result res = veil_volumetric_update(f->parts->volumetric, &d, rep->key, &f->field, &vr, err);
     if (res != VEIL_OK) return res;
     f->parts->has[VEIL_STAGE_VOLUMETRIC] = 1, f->parts->kept[VEIL_STAGE_VOLUMETRIC] = rep->key;
-    if (vr.skipped) { /* decide() found a grid; the module did not: say so rather than hide it */
+    if (vr.skipped && vr.cache.too_thick) {
+        rep->status = VEIL_STAGE_SKIPPED;
+        say(rep->why, sizeof rep->why, "no light cache: the medium is too thick for photons (about %.3g steps a "
+            "photon: %d photons would take over %d x the budget's %lld steps); orders >= 2 are left out",
+            vr.cache.steps, VEIL_CACHE_MIN_PHOTONS, VEIL_CACHE_STEPS_PER_PHOTON, d.cache.photons);
+    } else if (vr.skipped) { /* decide() found a grid; the module did not: say so rather than hide it */
         rep->status = VEIL_STAGE_SKIPPED;
         say(rep->why, sizeof rep->why, "no grid was made for the field");
+    } else if (d.kind == VEIL_FIELD_CACHE) {
+        const veil_cache_report* c = &vr.cache;
+        say(rep->why, sizeof rep->why, "the light cache: %lld photons from %d source%s, %dx%dx%d cells of %.4g m, "
+            "noise %.2g %% a cell (fluence-weighted RMS), %.1f MiB while built, %.1f MiB kept%s",
+            c->photons, c->sources, c->sources == 1 ? "" : "s", c->dims[0], c->dims[1], c->dims[2], (double)c->cell,
+            100.0 * c->noise, c->bytes / 1048576.0,
+            (double)c->dims[0] * c->dims[1] * c->dims[2] * 32.0 / 1048576.0,
+            c->cut || c->clamped ? "" : "");
+        if (c->asked > c->photons) {
+            size_t len = strlen(rep->why);
+            snprintf(rep->why + len, sizeof rep->why - len, "; %lld photons asked for, fewer in a medium this thick "
+                     "(about %.0f steps a photon)", c->asked, c->steps);
+        }
+        if (c->cut || c->clamped) {
+            size_t len = strlen(rep->why);
+            snprintf(rep->why + len, sizeof rep->why - len, "; %u photons cut at %d steps, %u scores clamped",
+                     c->cut, c->cap, c->clamped);
+        }
     }
     return VEIL_OK;
 }
@@ -579,7 +628,9 @@ static veil_stage_status render_decide(const veil_frame_plan* p, int kept, char*
     (void)kept;
     const veil_multiple* ms = &p->scene->multiple;
     char multiple[200] = "";
-    if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_DIFFUSION)
+    if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_CACHE)
+        snprintf(multiple, sizeof multiple, ", orders >= 2 from the light cache (stage volumetric)");
+    else if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_DIFFUSION)
         snprintf(multiple, sizeof multiple, ", multiple scattering from the diffusion field (stage volumetric)");
     else if (ms->volumetric && ms->octaves > 1)
         snprintf(multiple, sizeof multiple, ", volumetric multiple scattering: %d octaves (a %g, b %g, c %g) gated by %s",

@@ -75,6 +75,8 @@ typedef struct veil_quality_rung {
     float step_voxels;
     veil_opv_method method;
     float sun_across, sun_along;
+    long long cache_photons; /* the light cache's budget (volumetric/cache.h) */
+    int cache_cells;
 } veil_quality_rung;
 const veil_quality_rung* veil_quality_rung_of(veil_quality q); /* UNSET: the default rung */
 
@@ -103,6 +105,7 @@ typedef struct veil_frame_plan {
     /* veil_frame_plan_volume(): the lights that add light (the scene's, then the emission's) */
     veil_light lights[VEIL_MAX_LIGHTS];
     int light_count, emission_lights;
+    int glows;                      /* a voxelised source emits (the light cache traces its light) */
     veil_opv_params opv;            /* the propagation's method and parameters */
     /* the lights in the grid's index space, and the suns that get a light-space grid (as planned
      * without a device: at most VEIL_GL_MIN_3D_TEXTURE nodes an axis; propagate/opv_set.h) */

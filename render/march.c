@@ -80,7 +80,7 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
     const veil_multiple* ms = &lm->scene->multiple;
     if (d->field && d->field->texture) {
         set3(u->diffusion, d->field->tex_min, (float)d->field->kind);
-        set3(u->diffusion_inv, d->field->tex_inv, 0.0f);
+        set3(u->diffusion_inv, d->field->tex_inv, (float)d->field->depth);
     }
     if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_OCTAVE && ms->octaves > 1) {
         u->octave[0] = ms->octave_a, u->octave[1] = ms->octave_b, u->octave[2] = ms->octave_c;

@@ -145,8 +145,9 @@ typedef enum veil_spread_filter { VEIL_SPREAD_2X2 = 0, VEIL_SPREAD_4X4 = 1, VEIL
 typedef int veil_spread_interp;
 
 typedef enum veil_volumetric_method {
-    VEIL_VOLUMETRIC_OCTAVE = 0,   /* octaves in the march (render/shaders/march.comp) */
-    VEIL_VOLUMETRIC_DIFFUSION = 1 /* a diffusion solve on a coarse grid (volumetric/volumetric.h) */
+    VEIL_VOLUMETRIC_OCTAVE = 0,    /* octaves in the march (render/shaders/march.comp) */
+    VEIL_VOLUMETRIC_DIFFUSION = 1, /* a diffusion solve on a coarse grid (volumetric/volumetric.h) */
+    VEIL_VOLUMETRIC_CACHE = 2      /* the light cache: photons from every source (volumetric/cache.h) */
 } veil_volumetric_method;
 
 typedef enum veil_octave_gate {
@@ -160,6 +161,10 @@ typedef struct veil_multiple {
     veil_volumetric_method volumetric_method;
     int diffusion_cells;  /* the diffusion grid's cells along its longest side, 8..256 */
     int diffusion_iterations; /* red-black SOR sweeps; 0: 3 x the longest side */
+    /* the light cache (volumetric/cache.h) */
+    long long cache_photons; /* photons in all; 0: the quality rung's */
+    int cache_cells;         /* cells along the grid's longest side, 4..512; 0: the quality rung's */
+    unsigned cache_seed;     /* the cache's random stream: the same seed gives the same cache */
     /* screen-space */
     float c;              /* pixels: a level-k texel spreads by about c 2^(k-1) (paper: 0.86) */
     float mask_epsilon;   /* unitless: width of the leak mask, smoothstep(T, (1+eps) T, W) (paper: 2) */

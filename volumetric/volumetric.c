@@ -15,6 +15,8 @@ struct veil_volumetric {
     float cell;                   /* the kept field's cell (m), for the report */
     int sparse;                   /* ... and whether it is over a sparse volume */
     GLuint src, phi;    /* 3D textures of the kept field (0: none) */
+    veil_cache_programs cache;
+    veil_cache_report cache_rep; /* the kept cache's */
     int dims[3];
     veil_volumetric_field field;
     uint64_t key;
@@ -49,6 +51,7 @@ void veil_volumetric_clear(veil_volumetric* d)
     glDeleteTextures(1, &d->src);
     glDeleteTextures(1, &d->phi);
     d->src = d->phi = 0;
+    memset(&d->cache_rep, 0, sizeof d->cache_rep);
     memset(&d->field, 0, sizeof d->field);
     memset(d->dims, 0, sizeof d->dims);
     d->keyed = 0;
@@ -62,6 +65,7 @@ void veil_volumetric_destroy(veil_volumetric* d)
     glDeleteProgram(d->sor_program);
     glDeleteProgram(d->escape_program);
     glDeleteProgram(d->escape_sparse_program);
+    veil__cache_programs_free(&d->cache);
     glDeleteBuffers(1, &d->ubo);
     glDeleteBuffers(1, &d->medium_ubo);
     free(d);
@@ -98,6 +102,7 @@ static int grid_of(const veil_lit_medium* md, int cells, float lo[3], float* h, 
 
 int veil_volumetric_grid(const veil_volumetric_desc* d, float lo[3], float* h, int dims[3])
 {
+    if (d->kind == VEIL_FIELD_CACHE) return veil__cache_grid(&d->medium, d->cache.cells, lo, h, dims);
     return grid_of(&d->medium, d->kind == VEIL_FIELD_ESCAPE ? VEIL_ESCAPE_CELLS : d->diffusion_cells, lo, h, dims);
 }
 
@@ -170,6 +175,47 @@ static veil_result escape_sparse(veil_volumetric* d, const veil_lit_medium* md, 
     return veil_gl_check("escape field over a sparse volume (volumetric/shaders/escape.comp)", err);
 }
 
+/* "No field" kept under key: a later frame with the same key skips as well. */
+static veil_result keep_none(veil_volumetric* d, uint64_t key, veil_volumetric_report* rep)
+{
+    d->keyed = 1, d->key = key;
+    rep->skipped = 1;
+    return VEIL_OK;
+}
+
+/* The light cache (volumetric/cache.h) on its grid over the medium, dense or sparse alike. */
+static veil_result update_cache(veil_volumetric* d, const veil_volumetric_desc* vd, uint64_t key,
+                                veil_volumetric_field* field, veil_volumetric_report* rep, veil_error* err)
+{
+    const veil_lit_medium* md = &vd->medium;
+    float lo[3], h;
+    int dims[3];
+    rep->sparse = d->sparse = md->grid && md->sparse;
+    if (!veil_volumetric_grid(vd, lo, &h, dims)) return keep_none(d, key, rep);
+    veil_medium_block mu;
+    veil_lit_medium_fill(md, &mu);
+    veil_result r = veil__cache_build(&d->cache, md, &mu, lo, h, dims, &vd->cache, &d->phi, &d->cache_rep, err);
+    if (r != VEIL_OK) {
+        veil_volumetric_clear(d);
+        return r;
+    }
+    rep->cache = d->cache_rep;
+    if (!d->phi) return keep_none(d, key, rep); /* too thick for photons */
+    memcpy(d->dims, dims, sizeof dims);
+    for (int a = 0; a < 3; ++a) {
+        d->field.tex_min[a] = lo[a]; /* cell k spans lo + [k, k + 1] h: its centre is texel k's */
+        d->field.tex_inv[a] = 1.0f / ((float)dims[a] * h);
+    }
+    d->field.texture = d->phi;
+    d->field.depth = dims[2];
+    d->field.kind = VEIL_FIELD_CACHE;
+    d->keyed = 1, d->key = key;
+    *field = d->field;
+    memcpy(rep->dims, dims, sizeof rep->dims);
+    rep->cell = d->cell = h;
+    return VEIL_OK;
+}
+
 veil_result veil_volumetric_update(veil_volumetric* d, const veil_volumetric_desc* vd, uint64_t key,
                                    veil_volumetric_field* field, veil_volumetric_report* rep, veil_error* err)
 {
@@ -184,21 +230,19 @@ veil_result veil_volumetric_update(veil_volumetric* d, const veil_volumetric_des
         memcpy(rep->dims, d->dims, sizeof rep->dims);
         rep->cell = d->cell;
         rep->sparse = d->sparse;
+        rep->cache = d->cache_rep;
         return VEIL_OK;
     }
     veil_volumetric_clear(d);
     memset(field, 0, sizeof *field);
     float lo[3], h;
     int dims[3];
+    if (kind == VEIL_FIELD_CACHE) return update_cache(d, vd, key, field, rep, err);
     int escape = kind == VEIL_FIELD_ESCAPE;
     if (md->grid && md->sparse) {
         rep->sparse = 1;
         d->sparse = 1, d->cell = 0.0f;
-        if (!escape) { /* the diffusion solve needs a dense grid: no field */
-            d->keyed = 1, d->key = key;
-            rep->skipped = 1;
-            return VEIL_OK;
-        }
+        if (!escape) return keep_none(d, key, rep); /* the diffusion solve needs a dense grid: no field */
         veil_result r = escape_sparse(d, md, dims, err);
         if (r != VEIL_OK) {
             veil_volumetric_clear(d);
@@ -214,11 +258,7 @@ veil_result veil_volumetric_update(veil_volumetric* d, const veil_volumetric_des
         d->sparse = 1;
         return VEIL_OK;
     }
-    if (!veil_volumetric_grid(vd, lo, &h, dims)) {
-        d->keyed = 1, d->key = key;
-        rep->skipped = 1;
-        return VEIL_OK;
-    }
+    if (!veil_volumetric_grid(vd, lo, &h, dims)) return keep_none(d, key, rep);
     veil_medium_block mu;
     veil_lit_medium_fill(md, &mu);
     const veil_medium* m = &md->scene->medium;
@@ -301,15 +341,30 @@ veil_result veil_volumetric_update(veil_volumetric* d, const veil_volumetric_des
     return VEIL_OK;
 }
 
-float* veil_volumetric_readback(const veil_volumetric* d, int dims[3])
+/* The kept field's texture read back: its first (half = 0) or, for the light cache's stacked
+ * texture, its second grid (half = 1). */
+static float* readback(const veil_volumetric* d, int half, int dims[3])
 {
     if (!d->phi) return NULL;
+    const int stacked = d->field.kind == VEIL_FIELD_CACHE;
+    if (half && !stacked) return NULL;
     size_t n = (size_t)d->dims[0] * (size_t)d->dims[1] * (size_t)d->dims[2] * 4;
-    float* out = malloc(n * sizeof *out);
+    float* out = malloc((stacked ? 2 : 1) * n * sizeof *out);
     if (!out) return NULL;
-    glGetTextureImage(d->phi, 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * sizeof *out), out);
+    glGetTextureImage(d->phi, 0, GL_RGBA, GL_FLOAT, (GLsizei)((stacked ? 2 : 1) * n * sizeof *out), out);
+    if (half) memmove(out, out + n, n * sizeof *out);
     memcpy(dims, d->dims, 3 * sizeof *dims);
-    return out;
+    return out; /* (a stacked texture's second half stays allocated until it is freed) */
+}
+
+float* veil_volumetric_readback(const veil_volumetric* d, int dims[3])
+{
+    return readback(d, 0, dims);
+}
+
+float* veil_volumetric_readback_flux(const veil_volumetric* d, int dims[3])
+{
+    return readback(d, 1, dims);
 }
 
 uint64_t veil_volumetric_key(uint64_t ev_key, const veil_volumetric_desc* d)
@@ -324,6 +379,13 @@ uint64_t veil_volumetric_key(uint64_t ev_key, const veil_volumetric_desc* d)
     key = veil_hash_bytes(key, &escape, sizeof escape);
     key = veil_hash_bytes(key, &d->diffusion_cells, sizeof d->diffusion_cells);
     key = veil_hash_bytes(key, &d->diffusion_iterations, sizeof d->diffusion_iterations);
+    if (d->kind == VEIL_FIELD_CACHE) {
+        key = veil_hash_bytes(key, &d->kind, sizeof d->kind);
+        key = veil_hash_bytes(key, &d->cache.photons, sizeof d->cache.photons);
+        key = veil_hash_bytes(key, &d->cache.cells, sizeof d->cache.cells);
+        key = veil_hash_bytes(key, &d->cache.seed, sizeof d->cache.seed);
+        key = veil_hash_bytes(key, &d->cache.emission, sizeof d->cache.emission);
+    }
     for (size_t i = 0; i < s->medium.source_count; ++i)
         if (s->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL)
             key = veil_hash_bytes(key, &s->medium.sources[i].fog, sizeof s->medium.sources[i].fog);

@@ -22,6 +22,11 @@
  *   phi = 0 beyond the grid). The march then adds sigma_s rho phi / (4 pi)
  *   as in-scattering (the multiply scattered light, isotropic): orders >= 2.
  *
+ * - VEIL_FIELD_CACHE, the light cache (volumetric/cache.h): the fluence and
+ *   flux of light scattered at least once, traced by photons from every
+ *   light (and the medium's emission) on a grid over the medium; the march
+ *   scatters it once more (orders >= 2).
+ *
  * docs/multiple-scattering.md has the derivation and the measurements.
  * The stage's key and decision are frame/'s (frame/stages.c); this module
  * builds what it is asked for and keeps it under the key it is given.
@@ -36,6 +41,7 @@
 #include "../core/result.h"
 #include "../core/shared.glsl.h"
 #include "../propagate/lit_medium.h"
+#include "cache.h"
 
 #define VEIL_ESCAPE_CELLS 32 /* the escape field's cells along the longest side */
 #define VEIL_DIFFUSION_OMEGA 1.9f      /* SOR over-relaxation (optimal ~ 2 / (1 + sin(pi / n)), n ~ 64) */
@@ -47,6 +53,7 @@
 /* A field as the march reads it. */
 typedef struct veil_volumetric_field {
     GLuint texture;       /* rgba32f 3D, 0: none */
+    int depth;            /* the light cache: its grid's cells along z (the texture stacks two grids); else 0 */
     veil_field_kind kind; /* VEIL_FIELD_NONE when texture is 0 */
     float tex_min[3];     /* texture coordinates are (x - tex_min) * tex_inv */
     float tex_inv[3];
@@ -58,6 +65,7 @@ typedef struct veil_volumetric_desc {
     veil_lit_medium medium;   /* the EV, the lights and their optical depths */
     int diffusion_cells;      /* the fluence grid's cells along the longest side (8..256) */
     int diffusion_iterations; /* red-black sweeps; 0: 3 x the longest side */
+    veil_cache_settings cache; /* VEIL_FIELD_CACHE: photons, cells, seed, whether emission is a source */
 } veil_volumetric_desc;
 
 typedef struct veil_volumetric veil_volumetric;
@@ -70,6 +78,7 @@ typedef struct veil_volumetric_report {
     int skipped;     /* 1: no grid (no medium, or a fog box too large; the diffusion solve over a sparse volume) */
     int sparse;      /* 1: over a sparse volume (the escape field per kept brick, 3^3 points each) */
     uint64_t key;
+    veil_cache_report cache; /* VEIL_FIELD_CACHE: what the photons did (kept with the field) */
 } veil_volumetric_report;
 
 veil_result veil_volumetric_create(veil_volumetric** out, veil_error* err);
@@ -110,5 +119,7 @@ uint64_t veil_volumetric_key(uint64_t ev_key, const veil_volumetric_desc* d);
 /* The field read back (dims[0]*dims[1]*dims[2]*4 floats, rgb phi), for
  * tests; NULL when there is none. Caller frees. */
 float* veil_volumetric_readback(const veil_volumetric* v, int dims[3]);
+/* The light cache's flux read back the same way (xyz, w 0); NULL for other fields. */
+float* veil_volumetric_readback_flux(const veil_volumetric* v, int dims[3]);
 
 #endif

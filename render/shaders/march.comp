@@ -121,6 +121,23 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
     // scattered again, isotropically, towards the camera
     if (u.diffusion.w == float(VEIL_FIELD_FLUENCE))
         multi += texture(u_phi, (x - u.diffusion.xyz) * u.diffusion_inv.xyz).rgb * (1.0 / (4.0 * VEIL_PI));
+    // the light cache (volumetric/cache.h): the fluence phi of light scattered
+    // at least once (of the emission, all its light) as one HG lobe about its
+    // flux F with mean cosine |F| / phi, scattered by the medium's HG(g):
+    // HG(g |F| / phi) about F, towards the camera. The grid covers the medium;
+    // the texture stacks the fluence (z in [0, nz)) on the flux ([nz, 2 nz)).
+    if (u.diffusion.w == float(VEIL_FIELD_CACHE)) {
+        vec3 c = (x - u.diffusion.xyz) * u.diffusion_inv.xyz;
+        if (all(greaterThanEqual(c, vec3(0.0))) && all(lessThanEqual(c, vec3(1.0)))) {
+            float nz = u.diffusion_inv.w, z = clamp(c.z * nz, 0.5, nz - 0.5);
+            vec3 phi = texture(u_phi, vec3(c.xy, z / (2.0 * nz))).rgb;
+            vec3 F = texture(u_phi, vec3(c.xy, (z + nz) / (2.0 * nz))).xyz;
+            float pl = dot(phi, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B)), fl = length(F);
+            float gc = pl > 0.0 && fl > 0.0 ? min(fl / pl, 1.0) : 0.0;
+            vec3 axis = fl > 0.0 ? F / fl : vec3(0.0, 0.0, 1.0);
+            multi += max(phi, vec3(0.0)) * veil_phase_hg(dot(axis, -dir), med.shape.z * gc);
+        }
+    }
     return sum;
 }
 

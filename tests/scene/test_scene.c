@@ -173,15 +173,18 @@ static void test_multiple(void)
           "the paper's constants are the defaults");
     veil_scene_free(&s);
     r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'screen_space':false,'volumetric':true,"
-              "'volumetric_method':'diffusion','filter':'6x6','weights':[1,2,3,3,2,1],"
+              "'filter':'6x6','weights':[1,2,3,3,2,1],"
               "'interpolation':'cubic-bicubic','c':1.5,'levels':5,'octaves':4,'octave_gate':'legs',"
+              "'volumetric_method':'cache','cache_photons':4096,'cache_cells':12,'cache_seed':9,"
               "'separation':true,'separation_density':2,'separation_density_width':2}}", &s, &e);
     CHECK(r == VEIL_OK, "a full object: %s", e.msg);
     if (r == VEIL_OK) {
         const veil_multiple* m = &s.multiple;
-        CHECK(!m->screen_space && m->volumetric && m->volumetric_method == VEIL_VOLUMETRIC_DIFFUSION &&
+        CHECK(!m->screen_space && m->volumetric &&
               m->filter == VEIL_SPREAD_6X6 && m->interp == VEIL_INTERP_CUBIC_BICUBIC && m->c == 1.5f &&
               m->levels == 5 && m->octaves == 4 && m->octave_gate == VEIL_GATE_LEGS && m->separation &&
+              m->volumetric_method == VEIL_VOLUMETRIC_CACHE && m->cache_photons == 4096 && m->cache_cells == 12 &&
+              m->cache_seed == 9 &&
               m->sep_density == 2.0f && m->sep_density_width == 2.0f, "values read");
         double sum = 0.0;
         for (int i = 0; i < 6; ++i) sum += m->weights[i];
@@ -193,6 +196,16 @@ static void test_multiple(void)
     r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'filter':'2x2','weights':[0,0]}}", &s, &e);
     CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.weights: expected 2 weights with a sum in (0, 1e30]"),
           "zero weights refused: %s", e.msg);
+    r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'cache_cells':2}}", &s, &e);
+    CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.cache_cells: expected 0 (the quality's) or an "
+                                                 "integer in [4, 512], got 2"),
+          "a cache of 2 cells refused: %s", e.msg);
+    r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'cache_photons':-1}}", &s, &e);
+    CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.cache_photons: expected an integer in [0, "),
+          "negative photons refused: %s", e.msg);
+    r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'volumetric_method':'photons'}}", &s, &e);
+    CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.volumetric_method") && strstr(e.msg, "cache"),
+          "an unknown method refused, naming the known ones: %s", e.msg);
     r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'c':0}}", &s, &e);
     CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.c: expected a number in (0, 1e30]") &&
               strstr(e.msg, "(negative and zero values are not allowed)"), "c = 0: %s", e.msg);

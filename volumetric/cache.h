@@ -1,0 +1,90 @@
+/* veil — the light cache: the light that scattered at least once, traced
+ * from every source by photons on the GPU, kept on a coarse grid the march
+ * samples (VEIL_FIELD_CACHE, volumetric/volumetric.h). Part of the
+ * volumetric stage; internal to volumetric/.
+ *
+ * What it holds, per cell of a grid over the medium (the EV's box and the
+ * fogs' boxes): the fluence phi (W/m^2, rgb) of light that has scattered at
+ * least once — for the medium's emission, of all its light, scattered or
+ * not — and the luminance-weighted flux F (W/m^2, a vector). The march adds
+ *   sigma_s rho phi p_HG(F^ . w_o; g |F| / phi_lum)
+ * per unit length: the radiance field taken as one Henyey-Greenstein lobe
+ * about F with mean cosine |F| / phi (an HG lobe's first moment is g times
+ * its axis), scattered by the medium's HG(g); HG convolved with HG is HG
+ * with the product of the g's (their Legendre coefficients g^l multiply).
+ * So the march's own single scattering (exact, with the optical depths) plus
+ * the cache's orders >= 2 count every order once.
+ *
+ * The estimator (volumetric/shaders/cache_trace.comp): photons start at a
+ * source with power Phi (a sun: on a rectangle across its light covering
+ * the grid's box, E A / N each; a point or spot light: in a cone covering
+ * the box, or the whole sphere from inside, I Omega / N each, a spot's
+ * falloff applied per photon; emission: in a cell chosen with probability
+ * p_k proportional to its emission weight, 4 pi V eps(x) / (p_k N)), are
+ * tracked by delta tracking against the cells' majorants (cache_bounds.comp),
+ * and every piece of path of length l in a cell of volume V adds w l / V to
+ * its fluence (the track-length estimator: E[sum of l] over photons is the
+ * fluence times V) and lum(w) l omega / V to its flux.
+ *
+ * The fixed point: every score is at most s_max = 3 Phi_max sqrt(3) h / V
+ * (a photon's channel weights sum to at most 3 Phi_max and never grow,
+ * cache_trace.comp; a piece is at most a cell's diagonal), so with
+ * 2^VEIL_CACHE_FIXED_BITS units to s_max one add is an int32 and a cell's
+ * signed 64-bit sum holds 2^33 adds. Each add is floor(s u + xi): unbiased,
+ * within one unit (s_max 2^-30) of s; the noise it adds is below 1/2 unit
+ * per add in standard deviation, ~1e-9 of a score.
+ */
+#ifndef VEIL_CACHE_H
+#define VEIL_CACHE_H
+
+#include <epoxy/gl.h>
+#include <stdint.h>
+
+#include "../core/result.h"
+#include "../core/shared.glsl.h"
+#include "../propagate/lit_medium.h"
+
+/* The cache's budget and the one random stream it draws from. */
+typedef struct veil_cache_settings {
+    long long photons; /* in all, shared among the sources by their power (>= 1) */
+    int cells;         /* along the grid's longest side (4..512) */
+    uint32_t seed;     /* the same seed, medium and lights give the same cache, bit for bit */
+    int emission;      /* 1: the medium's emission is a source (the cache carries all its light) */
+} veil_cache_settings;
+
+typedef struct veil_cache_report {
+    int dims[3];
+    float cell;            /* m */
+    long long photons;     /* traced, all sources */
+    int sources;           /* lights (and the emission) that sent photons */
+    double noise;          /* the cells' relative noise, fluence-weighted RMS (odd against even photons) */
+    double bytes;          /* device memory while it is built (sums, majorants, the two fields) */
+    unsigned cut, clamped; /* photons cut at `cap` steps; scores over the fixed point's bound */
+    int cap;               /* a photon's step cap */
+    double steps;          /* the steps a photon takes, as estimated from the cells' majorants */
+    long long asked;       /* the photons the budget asked for (more than `photons`: the medium is thick) */
+    int too_thick;         /* 1: no cache (*tex 0): even VEIL_CACHE_MIN_PHOTONS would take over the budget */
+} veil_cache_report;
+
+/* Programs of the cache's passes (dense, and sparse made when first needed). */
+typedef struct veil_cache_programs {
+    GLuint bounds[2], trace[2], resolve, ubo;
+} veil_cache_programs;
+
+veil_result veil__cache_programs(veil_cache_programs* p, int sparse, veil_error* err);
+void veil__cache_programs_free(veil_cache_programs* p);
+
+/* The grid: its min corner lo, cell edge h and dims, over the EV's box and
+ * the fogs' boxes (the EV's alone when they would be wider than
+ * VEIL_DIFFUSION_MAX_EXTENT), `cells` along the longest side. 0: none. */
+int veil__cache_grid(const veil_lit_medium* md, int cells, float lo[3], float* h, int dims[3]);
+
+/* Builds the cache of md on the grid (lo, h, dims) into a new rgba32f
+ * texture of dims[0] x dims[1] x 2 dims[2] texels: the fluence rgb (a: the
+ * odd photons' luminance fluence) at z < dims[2], the flux xyz above. The
+ * medium block mu is md's (veil_lit_medium_fill). */
+veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md, const veil_medium_block* mu,
+                              const float lo[3], float h, const int dims[3], const veil_cache_settings* s,
+                              GLuint* tex, veil_cache_report* rep, veil_error* err);
+
+#endif

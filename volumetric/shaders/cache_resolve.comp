@@ -1,0 +1,28 @@
+// veil — the light cache's last pass (volumetric/cache.h): each cell's
+// 64-bit fixed-point sums turned into the fields the march samples, stacked
+// in one texture (core/shared.glsl.h says why): the fluence rgb (W/m^2) with
+// the odd photons' luminance fluence beside it (for the noise estimate), and
+// nz cells above it the luminance-weighted flux (W/m^2).
+layout(local_size_x = VEIL_CACHE_CELL_GROUP, local_size_y = VEIL_CACHE_CELL_GROUP, local_size_z = VEIL_CACHE_CELL_GROUP) in;
+layout(std140, binding = VEIL_UBO_CACHE) uniform veil_cache_ubo { veil_cache_block cb; };
+layout(std430, binding = VEIL_BIND_CACHE_SUM) readonly buffer veil_cache_sums { uint sums[]; };
+layout(binding = VEIL_IMAGE_CACHE, rgba32f) writeonly uniform image3D u_cache; // fluence below, flux above
+
+// the signed 64-bit sum at word k, in W/m^2: the high word and the low
+// word's two halves joined in steps that are exact while |sum| < 2^40 units
+// (a negative sum near 0 keeps its low bits), rounded to float's 24 bits after
+float sum_at(uint k)
+{
+    uint lo = sums[k];
+    float v = (float(int(sums[k + 1u])) * 65536.0 + float(lo >> 16u)) * 65536.0 + float(lo & 0xffffu);
+    return v * cb.scale.y;
+}
+
+void main()
+{
+    ivec3 c = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(c, cb.dims.xyz))) return;
+    uint k = (uint(c.x) + uint(cb.dims.x) * (uint(c.y) + uint(cb.dims.y) * uint(c.z))) * uint(VEIL_CACHE_WORDS);
+    imageStore(u_cache, c, vec4(sum_at(k), sum_at(k + 2u), sum_at(k + 4u), sum_at(k + 12u)));
+    imageStore(u_cache, c + ivec3(0, 0, cb.dims.z), vec4(sum_at(k + 6u), sum_at(k + 8u), sum_at(k + 10u), 0.0));
+}

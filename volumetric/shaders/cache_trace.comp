@@ -1,0 +1,182 @@
+// veil — the light cache's photons (volumetric/cache.h): one invocation a
+// photon of one source (a sun, a point or spot light, or the medium's
+// emission), traced through the medium by delta tracking against the
+// cells' majorants, scoring the track-length estimator of the fluence and
+// its flux in every cell it crosses after its first scattering (from its
+// start for emission: the cache then carries emission's every order).
+//
+// Colour: one path for the three channels (spectral tracking, Kutz et al.
+// 2017, with probabilities from the history-aware average): at a tentative
+// collision the photon is absorbed, scattered or goes on with probabilities
+//   P_x = sum_c w_c sigma_x,c / (sigma_bar sum_c w_c)
+// (sigma_n,c = sigma_bar - sigma_t,c, the null part) and each weight w_c
+// becomes w_c sigma_x,c / (sigma_bar P_x): unbiased per channel, and the
+// weights' sum never changes (so every weight stays below the photon's
+// first power summed over the channels: the bound the fixed point is cut
+// to). A grey medium keeps the weights: analog absorption.
+// Determinism: the random numbers of photon n come from (seed, source, n)
+// alone, and the sums are integers: the cache does not depend on the order
+// the GPU runs the photons in.
+layout(local_size_x = VEIL_CACHE_GROUP) in;
+//@include propagate/shaders/lit_medium.glsl
+//@include volumetric/shaders/cache_common.glsl
+layout(std430, binding = VEIL_BIND_CACHE_SUM) coherent buffer veil_cache_sums { uint sums[]; };
+layout(std430, binding = VEIL_BIND_CACHE_CELL) readonly buffer veil_cache_cells { vec2 cells[]; };
+layout(std430, binding = VEIL_BIND_CACHE_EMIT) readonly buffer veil_cache_emit { uvec4 emitters[]; };
+layout(std430, binding = VEIL_BIND_CACHE_COUNT) coherent buffer veil_cache_count { uint counts[]; };
+
+uint state;
+
+uint mix32(uint x)
+{
+    x ^= x >> 16; x *= 0x7feb352du;
+    x ^= x >> 15; x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+// PCG (O'Neill 2014: an LCG step, a permuted output): 24 bits in [0, 1)
+float rnd()
+{
+    state = state * 747796405u + 2891336453u;
+    uint w = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    w = (w >> 22u) ^ w;
+    return float(w >> 8) * (1.0 / 16777216.0);
+}
+
+// A signed 64-bit add of v to the word pair at k (low word first): the low
+// word's atomic returns what it held, so its carry is known; the high word
+// gets the carry and v's sign extension. Any order of adds gives the same sum.
+void add64(uint k, int v)
+{
+    if (v == 0) return;
+    uint u = uint(v);
+    uint old = atomicAdd(sums[k], u);
+    uint hi = (v < 0 ? 0xffffffffu : 0u) + (old + u < old ? 1u : 0u);
+    if (hi != 0u) atomicAdd(sums[k + 1u], hi);
+}
+
+// A piece of path of length len in cell c, weights w, travelling along d.
+void score(ivec3 c, vec3 w, vec3 d, float len, bool odd)
+{
+    uint k = (uint(c.x) + uint(cb.dims.x) * (uint(c.y) + uint(cb.dims.y) * uint(c.z))) * uint(VEIL_CACHE_WORDS);
+    float u = len * cb.scale.z * cb.scale.x; // units per W of weight
+    float xi = rnd();
+    float wl = dot(w, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B));
+    add64(k + 0u, veil_cache_fixed(w.r * u, xi));
+    add64(k + 2u, veil_cache_fixed(w.g * u, xi));
+    add64(k + 4u, veil_cache_fixed(w.b * u, xi));
+    add64(k + 6u, veil_cache_fixed(wl * u * d.x, xi));
+    add64(k + 8u, veil_cache_fixed(wl * u * d.y, xi));
+    add64(k + 10u, veil_cache_fixed(wl * u * d.z, xi));
+    if (odd) add64(k + 12u, veil_cache_fixed(wl * u, xi));
+    if (max(w.r, max(w.g, w.b)) * u > float(1 << VEIL_CACHE_FIXED_BITS)) atomicAdd(counts[1], 1u);
+}
+
+// A unit vector at cos_t from axis a, azimuth phi.
+vec3 around(vec3 a, float cos_t, float phi)
+{
+    vec3 t = abs(a.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+    vec3 u = normalize(cross(a, t)), v = cross(a, u);
+    float sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));
+    return normalize(a * cos_t + (u * cos(phi) + v * sin(phi)) * sin_t);
+}
+
+// A direction scattered from d by Henyey-Greenstein g (inverting its CDF in cos).
+vec3 scatter_hg(vec3 d, float g)
+{
+    float xi = rnd(), cos_t;
+    if (abs(g) < 1e-3) cos_t = 1.0 - 2.0 * xi;
+    else {
+        float s = (1.0 - g * g) / (1.0 - g + 2.0 * g * xi);
+        cos_t = clamp((1.0 + g * g - s * s) / (2.0 * g), -1.0, 1.0);
+    }
+    return around(d, cos_t, 2.0 * VEIL_PI * rnd());
+}
+
+void main()
+{
+    uint n = cb.source.z + gl_GlobalInvocationID.x;
+    if (n >= cb.source.w) return;
+    state = mix32(cb.seed.x ^ mix32(cb.seed.y * 0x9e3779b9u ^ mix32(n)));
+    float h = cb.origin.w;
+    vec3 grid_hi = cb.origin.xyz + vec3(cb.dims.xyz) * h;
+    vec3 pos, dir, w = cb.power.rgb;
+    bool scored = false, odd = (n & 1u) != 0u;
+    if (cb.source.x == uint(VEIL_CACHE_SUN)) {
+        pos = cb.src0.xyz + rnd() * cb.src1.xyz + rnd() * cb.src2.xyz;
+        dir = cb.src3.xyz;
+    } else if (cb.source.x == uint(VEIL_CACHE_CONE)) {
+        pos = cb.src0.xyz;
+        dir = around(cb.src1.xyz, 1.0 - rnd() * (1.0 - cb.src1.w), 2.0 * VEIL_PI * rnd());
+        int l = int(cb.source.y);
+        if (int(med.lights[l].position.w) == VEIL_LIGHT_SPOT)
+            w *= veil_spot_falloff(dot(dir, med.lights[l].direction.xyz), med.lights[l].direction.w, med.lights[l].color.w);
+    } else {
+        // an emitting cell by its CDF (binary search for the first entry above xi), uniform within it
+        float xi = rnd();
+        int a = 0, b = cb.dims.w - 1;
+        while (a < b) {
+            int m = (a + b) / 2;
+            if (uintBitsToFloat(emitters[m].y) > xi) b = m; else a = m + 1;
+        }
+        uint k = emitters[a].x;
+        ivec3 c = ivec3(int(k % uint(cb.dims.x)), int((k / uint(cb.dims.x)) % uint(cb.dims.y)),
+                        int(k / uint(cb.dims.x * cb.dims.y)));
+        pos = cb.origin.xyz + (vec3(c) + vec3(rnd(), rnd(), rnd())) * h;
+        w *= in_ev_box(pos) ? cache_emission(pos) / uintBitsToFloat(emitters[a].z) : vec3(0.0);
+        dir = around(vec3(0.0, 0.0, 1.0), 1.0 - 2.0 * rnd(), 2.0 * VEIL_PI * rnd());
+        scored = true;
+    }
+    if (!(max(w.r, max(w.g, w.b)) > 0.0)) return;
+    vec2 span = box_hit(pos, dir, cb.origin.xyz, grid_hi, 0.0, INF);
+    if (span.x >= span.y) return;
+    pos += dir * span.x;
+    ivec3 c = clamp(ivec3(floor((pos - cb.origin.xyz) / h)), ivec3(0), cb.dims.xyz - 1);
+    ivec3 step_dir = ivec3(sign(dir));
+    float tau = -log(1.0 - rnd()); // the majorant's optical depth to the next tentative collision
+    float g = cb.sigma_s.w;
+    int steps = 0;
+    const int cap = int(cb.seed.z);
+    for (; steps < cap; ++steps) {
+        // where the path leaves cell c
+        vec3 lo = cb.origin.xyz + vec3(c) * h;
+        vec3 t3 = vec3(INF);
+        for (int a = 0; a < 3; ++a)
+            if (dir[a] != 0.0) t3[a] = max(((dir[a] > 0.0 ? lo[a] + h : lo[a]) - pos[a]) / dir[a], 0.0);
+        float t_exit = min(t3.x, min(t3.y, t3.z));
+        int axis = t3.x == t_exit ? 0 : (t3.y == t_exit ? 1 : 2);
+        uint k = uint(c.x) + uint(cb.dims.x) * (uint(c.y) + uint(cb.dims.y) * uint(c.z));
+        float maj = cells[k].x * cb.scale.w;
+        if (maj > 0.0) maj = max(maj, cb.sigma_a.w);
+        if (maj * t_exit <= tau) { // no collision in the cell: on to the next
+            if (scored) score(c, w, dir, t_exit, odd);
+            tau -= maj * t_exit;
+            pos += dir * t_exit;
+            c[axis] += step_dir[axis];
+            if (c[axis] < 0 || c[axis] >= cb.dims[axis]) break;
+            continue;
+        }
+        float t = tau / maj;
+        if (scored) score(c, w, dir, t, odd);
+        pos += dir * t;
+        // a tentative collision: absorbed, scattered or null
+        float rho = cache_density(pos);
+        vec3 s_s = rho * cb.sigma_s.rgb, s_a = rho * cb.sigma_a.rgb;
+        vec3 s_n = max(vec3(maj) - s_s - s_a, vec3(0.0));
+        float sw = maj * (w.r + w.g + w.b);
+        float p_s = dot(w, s_s) / sw, p_a = dot(w, s_a) / sw, p_n = dot(w, s_n) / sw;
+        float xi = rnd() * (p_s + p_a + p_n); // their sum is 1 but for rounding
+        if (xi < p_a) break;
+        if (xi < p_a + p_s) {
+            w *= s_s / (maj * p_s);
+            dir = scatter_hg(dir, g);
+            step_dir = ivec3(sign(dir));
+            scored = true;
+        } else {
+            w *= s_n / (maj * p_n);
+        }
+        tau = -log(1.0 - rnd());
+    }
+    if (steps == cap) atomicAdd(counts[0], 1u);
+}
