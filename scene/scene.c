@@ -92,9 +92,12 @@ void veil_multiple_defaults(veil_multiple* m)
     memset(m, 0, sizeof *m);
     m->screen_space = 1;
     m->volumetric = 1;
-    m->volumetric_method = VEIL_VOLUMETRIC_OCTAVE;
+    m->volumetric_method = VEIL_VOLUMETRIC_CACHE;
     m->diffusion_cells = 64;
     m->diffusion_iterations = 0;
+    m->cache_photons = 0;
+    m->cache_cells = 0;
+    m->cache_seed = 1;
     m->c = 0.86f;
     m->mask_epsilon = 2.0f;
     m->mask = 1;

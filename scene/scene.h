@@ -137,9 +137,12 @@ typedef struct veil_medium {
  *    Elek et al. 2013): the light scattered out of each pixel's beam (of the
  *    background, and of the single scattering on its way to the camera) is
  *    spread with Premoze's Gaussian width W(P), through MIP chains;
- *  - volumetric: the octave approximation (Wrenninge et al. 2013): each
- *    light's in-scattering is repeated with the optical depth scaled by a^i,
- *    the contribution by b^i and the phase function's g by c^i. */
+ *  - volumetric: by default the light cache (volumetric/cache.h): photons
+ *    from every light and the emission, their fluence and flux on a grid
+ *    the march scatters once more (orders >= 2); or the octave approximation
+ *    (Wrenninge et al. 2013): each light's in-scattering is repeated with the
+ *    optical depth scaled by a^i, the contribution by b^i and the phase
+ *    function's g by c^i; or a diffusion solve. */
 typedef enum veil_spread_filter { VEIL_SPREAD_2X2 = 0, VEIL_SPREAD_4X4 = 1, VEIL_SPREAD_6X6 = 2 } veil_spread_filter;
 /* VEIL_INTERP_* (core/shared.glsl.h: the fetch shader reads the same values) */
 typedef int veil_spread_interp;

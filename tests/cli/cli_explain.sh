@@ -36,8 +36,9 @@ grep -c '^render .*(ran: ' "$tmp/stats.txt" | grep -qx 2 || fail "render did not
 # the multiple-scattering field is view-independent: made once, kept for frame 1
 grep -c '^volumetric .*(ran: ' "$tmp/stats.txt" | grep -qx 1 || fail "the volumetric field did not run once: $(cat "$tmp/stats.txt")"
 grep -c '^volumetric .*(cached: ' "$tmp/stats.txt" | grep -qx 1 || fail "frame 1 rebuilt the volumetric field"
-grep -q '^volumetric .*gated by the escape field' "$tmp/plan.txt" || grep -q 'gated by the escape field' "$tmp/plan.txt" \
-    || fail "the plan does not name the octaves' gate: $(cat "$tmp/plan.txt")"
+grep -q 'the light cache, [0-9]* photons from 3 sources' "$tmp/plan.txt" \
+    || fail "the plan does not name the light cache: $(cat "$tmp/plan.txt")"
+grep -q 'orders >= 2 from the light cache' "$tmp/plan.txt" || fail "the march's plan does not say it reads the cache"
 grep -c '^spread .*(skipped: nothing to spread' "$tmp/stats.txt" | grep -qx 2 || fail "the spread was not skipped (and said why)"
 ok
 

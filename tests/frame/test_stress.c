@@ -33,6 +33,7 @@
  *    counted and printed.
  * A scene the library rejects with an error is counted (and its message
  * shown); more than 5 % rejected means the generator makes invalid scenes.
+ * Multiple scattering is the default (the light cache), on a small budget.
  *   test_stress [SCENES [SEED [FIRST]]]   (default 500 scenes, seed 3, from scene 0)
  * Scene i draws from its own stream (SEED, i): `test_stress 1 SEED i` redoes it alone. */
 #include <float.h>
@@ -363,7 +364,10 @@ static void gen_scene_json(sbuf* b, gen_scene* g)
     sb_add(b, "], ");
     gen_camera(b, g);
     colour(bg, 1e-2, 1e1, 1.0, 0.3);
-    sb_add(b, ", \"background\": {\"color\": " VF "}}", V3(bg));
+    /* the light cache on a small budget (its guard against thick media and its bounds are what is
+     * stressed, not its noise): 4096 photons, 8 cells */
+    sb_add(b, ", \"background\": {\"color\": " VF "}, \"multiple_scattering\": {\"cache_photons\": 4096, "
+              "\"cache_cells\": 8}}", V3(bg));
 }
 
 /* ---- checks ----------------------------------------------------------------- */
