@@ -1,17 +1,23 @@
 #!/usr/bin/env python3
 """veil multiple-scattering benchmark: time against error of single scattering
-alone, + the screen-space spread, + the volumetric (octave) estimate, and the
-default, against the all-orders path tracer (`veil reference --max-order 0`).
+alone, the octaves, and the light cache at every quality rung (with single
+scattering at the same rung beside it, for the time ratio), against the
+all-orders path tracer (`veil reference --max-order 0`).
 
     python3 bench/multiple_scattering.py [--quick] [--size WxH] [--spp N]
-        [--runs R] [--scenes a,b,...] [--study] [--veil build/veil]
+        [--runs R] [--scenes a,b,...] [--candidates] [--study] [--veil build/veil]
+    python3 bench/multiple_scattering.py --converge "demo,cumulus, sun behind" [--size WxH] [--spp N]
+
+--converge: the cache's error against its budget (photons doubling, then
+cells), into docs/results/cache_convergence.{md,dat,png}.
 
 For each scene (at two optical thicknesses: the file's sigma_a, sigma_s and
 those times --thick) it renders every variant with `veil render --stats`
 (time: the median over --runs of the sum of the stages' wall times, i.e. a
 still frame without process start and file writing; per turntable frame:
 render + spread, the stages a moving camera re-runs; the volumetric field
-is view-independent and kept), and compares it with
+is view-independent and kept). The smoke (../shared/data) is also measured
+at --thick times its coefficients., and compares it with
 `veil compare --bin 4 --json`: rel_rmse_excess (relative RMSE of 4x4-pixel
 means with the reference's own noise taken out in quadrature) and
 mean_bias (mean RGB / reference's - 1). --study adds the screen-space
@@ -30,18 +36,31 @@ import argparse, hashlib, json, os, statistics, subprocess, sys, tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHARED = os.path.join(os.path.dirname(ROOT), "shared", "data")
 
+CACHE = {"screen_space": False, "volumetric": True, "volumetric_method": "cache"}
+# (name, multiple_scattering fields, quality rung): single scattering and the light cache at every rung
+# (the cache's budget is the rung's: frame/stages.c), the octaves and the other candidates at the default
 VARIANTS = [
-    ("ss", {"screen_space": False, "volumetric": False}),
-    ("ss+screen", {"screen_space": True, "volumetric": False}),
-    # the first fit: octaves gated by the legs through each point
-    ("ss+octave legs", {"screen_space": False, "volumetric": True, "octave_gate": "legs", "octaves": 3,
-                        "octave_extinction": 0.3, "octave_contribution": 0.75, "octave_eccentricity": 0.6}),
-    ("ss+octave escape", {"screen_space": False, "volumetric": True, "octave_gate": "escape"}),
-    ("ss+diffusion", {"screen_space": False, "volumetric": True, "volumetric_method": "diffusion"}),
-    ("default", None),  # the scene's own settings: the defaults
+    ("ss", {"screen_space": False, "volumetric": False}, "default"),
+    ("octaves", {"screen_space": False, "volumetric": True, "volumetric_method": "octave", "octave_gate": "escape"},
+     "default"),
+    ("ss draft", {"screen_space": False, "volumetric": False}, "draft"),
+    ("cache draft", CACHE, "draft"),
+    ("cache default", CACHE, "default"),
+    ("ss high", {"screen_space": False, "volumetric": False}, "high"),
+    ("cache high", CACHE, "high"),
+    ("ss max", {"screen_space": False, "volumetric": False}, "max"),
+    ("cache max", CACHE, "max"),
 ]
-STUDY = [("screen %s %s" % (f, i), {"screen_space": True, "volumetric": False, "filter": f, "interpolation": i})
-         for f in ("2x2", "4x4", "6x6") for i in ("linear-bilinear", "linear-bicubic", "cubic-bicubic")]
+# the earlier candidates (docs/multiple-scattering.md), with --candidates
+CANDIDATES = [
+    ("ss+screen", {"screen_space": True, "volumetric": False}, "default"),
+    ("ss+octave legs", {"screen_space": False, "volumetric": True, "volumetric_method": "octave", "octave_gate": "legs",
+                        "octaves": 3, "octave_extinction": 0.3, "octave_contribution": 0.75,
+                        "octave_eccentricity": 0.6}, "default"),
+    ("ss+diffusion", {"screen_space": False, "volumetric": True, "volumetric_method": "diffusion"}, "default"),
+]
+STUDY = [("screen %s %s" % (f, i), {"screen_space": True, "volumetric": False, "filter": f, "interpolation": i},
+          "default") for f in ("2x2", "4x4", "6x6") for i in ("linear-bilinear", "linear-bicubic", "cubic-bicubic")]
 
 
 def shared_scene(vdb, camera, sigma_a, sigma_s, g, lights, scale=1.0):
@@ -52,13 +71,45 @@ def shared_scene(vdb, camera, sigma_a, sigma_s, g, lights, scale=1.0):
             "lights": lights, "background": {"color": [0.0, 0.0, 0.0]}}
 
 
+def cumulus(direction):
+    """The cloud scene's puffs as a bright cumulus (albedo 0.999, HG g 0.85), one sun: what cloud renderers
+    are judged on; the octaves were never fitted on it."""
+    with open(os.path.join(ROOT, "data", "scenes", "cloud.json")) as f:
+        s = json.load(f)
+    s["medium"]["sigma_s"] = [1.6, 1.6, 1.6]
+    s["medium"]["sigma_a"] = [0.0016, 0.0016, 0.0016]
+    s["medium"]["phase"] = {"type": "hg", "g": 0.85}
+    s["lights"] = [{"type": "directional", "direction": direction, "irradiance": [3.0, 2.9, 2.7]}]
+    s["background"] = {"color": [0.0, 0.0, 0.0]}
+    return s
+
+
+def fog_lamp():
+    """Dense fog (about 2.5 optical depths to the walls) with a lamp inside it, never fitted on."""
+    return {"camera": {"position": [0.0, 1.5, 4.0], "look_at": [0.0, 1.2, -2.0], "fov_y_deg": 55,
+                       "width": 640, "height": 480},
+            "medium": {"sigma_a": [0.03, 0.03, 0.03], "sigma_s": [0.9, 0.92, 0.95], "phase": {"type": "hg", "g": 0.4},
+                       "sources": [{"type": "exponential", "density": 1.0, "falloff": 0.0, "direction": [0, 1, 0],
+                                    "origin": [0, 0, 0], "bounds": [[-3.0, 0.0, -5.0], [3.0, 3.0, 5.0]]}]},
+            "lights": [{"type": "point", "position": [0.3, 1.6, -1.5], "intensity": [6.0, 4.5, 2.5]}],
+            "background": {"color": [0.0, 0.0, 0.0]}}
+
+
 def scenes():
-    """(name, scene dict, folder for relative paths, fitted-on?)"""
+    """(name, scene dict, folder for relative paths, fitted-on?, also at --thick?)"""
     out = []
-    for name, fit in (("fog_lights", True), ("demo", True), ("cloud", True), ("vdb_smoke", True)):
+    for name, fit in (("fog_lights", True), ("demo", True), ("cloud", True), ("vdb_smoke", True), ("pyro", False)):
         path = os.path.join(ROOT, "data", "scenes", name + ".json")
         with open(path) as f:
-            out.append((name, json.load(f), os.path.dirname(path), fit))
+            sc = json.load(f)
+        vdbs = [src["file"] for src in sc["medium"].get("sources", []) if src.get("type") == "vdb"]
+        if any(not os.path.exists(os.path.join(os.path.dirname(path), v)) for v in vdbs):
+            print("skipped %s: run make data first" % name, file=sys.stderr)
+            continue
+        out.append((name, sc, os.path.dirname(path), fit, False))
+    out.append(("cumulus, sun behind", cumulus([0.1, -0.35, 0.93]), ROOT, False, False))
+    out.append(("cumulus, sun at the side", cumulus([-0.95, -0.3, 0.05]), ROOT, False, False))
+    out.append(("dense fog, lamp inside", fog_lamp(), ROOT, False, False))
     smoke = os.path.join(SHARED, "smoke.vdb")
     if os.path.exists(smoke):
         # index (1,2,1)..(111,223,112), voxel 0.476: about 53 x 106 x 53 m
@@ -67,13 +118,13 @@ def scenes():
         lights = [{"type": "directional", "direction": [0.45, -0.7, -0.55], "irradiance": [2.6, 2.5, 2.3]},
                   {"type": "point", "position": [26.0, 30.0, 26.0], "intensity": [900.0, 500.0, 200.0]}]
         out.append(("smoke.vdb", shared_scene(smoke, cam, [0.007, 0.007, 0.007], [0.093, 0.093, 0.093], 0.3,
-                                              lights), ROOT, False))
+                                              lights), ROOT, False, True))
     dragon = os.path.join(SHARED, "dragon_with_xform.vdb")
     if os.path.exists(dragon):
         cam = {"position": [0.0, 1.0, 9.0], "look_at": [0.0, 0.0, 0.0], "fov_y_deg": 40, "width": 640, "height": 480}
         lights = [{"type": "directional", "direction": [0.4, -0.7, -0.6], "irradiance": [3.0, 2.9, 2.7]}]
         out.append(("dragon.vdb (albedo 0.99)", shared_scene(dragon, cam, [0.02, 0.02, 0.02], [2.0, 2.0, 2.0], 0.6,
-                                                             lights), ROOT, False))
+                                                             lights), ROOT, False, False))
     return out
 
 
@@ -130,6 +181,76 @@ def stage_ms(stats_text):
     return ms
 
 
+def reference(scene, label, w, h, spp, ref_veil, cache, tmp):
+    """The all-orders reference of scene (its multiple_scattering settings do not matter to it), cached."""
+    text = json.dumps(with_ms(scene, None), sort_keys=True)
+    ref = os.path.join(cache, reference_key(text, w, h, spp, ref_veil) + ".exr")
+    if not os.path.exists(ref):
+        sp = os.path.join(tmp, "ref.json")
+        with open(sp, "w") as f:
+            f.write(text)
+        print("reference %s: %dx%d, %d spp ..." % (label, w, h, spp), file=sys.stderr, flush=True)
+        out = run([ref_veil, "reference", sp, "-o", ref + ".part.exr", "--spp", str(spp), "--width", str(w),
+                   "--height", str(h)])
+        os.replace(ref + ".part.exr", ref)
+        print(out.strip().splitlines()[0], file=sys.stderr)
+    return ref
+
+
+def converge(a, names, w, h, spp, ref_veil, cache, tmp):
+    """The cache's error against its budget: photons doubling at the max rung's cells, then cells at the
+    largest photon count, until the reference's noise; each with the cache stage's time."""
+    rows = []
+    for name, base, folder, fit, thick in scenes():
+        if name not in names:
+            continue
+        scene = absolutise(base, folder)
+        ref = reference(scene, name, w, h, spp, ref_veil, cache, tmp)
+        budgets = [(1 << p, 96) for p in range(12, 23)] + [(1 << 22, c) for c in (16, 24, 40, 64)]
+        for photons, cells in budgets:
+            ms = dict(CACHE, cache_photons=photons, cache_cells=cells)
+            sp = os.path.join(tmp, "v.json")
+            with open(sp, "w") as f:
+                json.dump(with_ms(scene, ms), f)
+            img = os.path.join(tmp, "v.exr")
+            st = stage_ms(run([a.veil, "render", sp, "-o", img, "--width", str(w), "--height", str(h), "--quality",
+                               "max", "--stats"]))
+            c = json.loads(run([a.veil, "compare", img, ref, "--bin", "4", "--json"]))
+            row = {"scene": name, "photons": photons, "cells": cells, "cache_ms": st.get("volumetric", 0.0),
+                   "rel_rmse_excess_bin4": c["rel_rmse_excess"], "mean_bias": c["mean_bias"], "noise_bin4": c["noise"]}
+            rows.append(row)
+            print("%-24s %9d photons %3d cells %9.0f ms  err %6.2f %%  bias %+6.2f %%  (ref noise %.2f %%)" % (
+                name, photons, cells, row["cache_ms"], 100 * row["rel_rmse_excess_bin4"], 100 * row["mean_bias"],
+                100 * row["noise_bin4"]), flush=True)
+    base = os.path.join(a.out, "cache_convergence")
+    with open(base + ".md", "w") as f:
+        f.write("| scene | photons | cells | cache (ms) | rel. RMSE 4x4, noise out | mean bias | ref. noise 4x4 |\n"
+                "|---|---:|---:|---:|---:|---:|---:|\n")
+        for r in rows:
+            f.write("| %s | %d | %d | %.0f | %.2f %% | %+.2f %% | %.2f %% |\n" % (
+                r["scene"], r["photons"], r["cells"], r["cache_ms"], 100 * r["rel_rmse_excess_bin4"],
+                100 * r["mean_bias"], 100 * r["noise_bin4"]))
+    with open(base + ".dat", "w") as f:
+        for n in names:
+            f.write("# %s\n" % n)
+            for r in rows:
+                if r["scene"] == n and r["cells"] == 96:
+                    f.write("%d %g %g\n" % (r["photons"], 100 * r["rel_rmse_excess_bin4"], 100 * r["noise_bin4"]))
+            f.write("\n\n")
+    try:
+        plot = "; ".join([
+            "set terminal pngcairo size 900,600", "set output '%s.png'" % base, "set logscale xy",
+            "set xlabel 'photons (96 cells along the longest side)'",
+            "set ylabel 'rel. RMSE of 4x4 means vs all orders, noise out (%)'", "set key outside",
+            "plot " + ", ".join("'%s.dat' index %d using 1:2 with linespoints title '%s', "
+                                "'%s.dat' index %d using 1:3 with lines dashtype 2 title '%s: reference noise'"
+                                % (base, i, n, base, i, n) for i, n in enumerate(names))])
+        subprocess.run(["gnuplot", "-e", plot], check=True)
+    except (OSError, subprocess.CalledProcessError) as e:
+        print("no plot (%s)" % e, file=sys.stderr)
+    print("wrote %s.md" % base, file=sys.stderr)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
@@ -139,6 +260,8 @@ def main():
     ap.add_argument("--thick", type=float, default=3.0)
     ap.add_argument("--scenes", default="")
     ap.add_argument("--study", action="store_true")
+    ap.add_argument("--candidates", action="store_true", help="also the earlier candidates (screen, legs, diffusion)")
+    ap.add_argument("--converge", default="", help="scenes (comma-separated): the cache's error against its budget")
     ap.add_argument("--veil", default=os.path.join(ROOT, "build", "veil"))
     ap.add_argument("--ref-veil", default="", help="the veil that renders the references (default: --veil)")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "results"))
@@ -152,26 +275,17 @@ def main():
     tmp = tempfile.mkdtemp(prefix="veil-ms-")
     wanted = [s for s in a.scenes.split(",") if s]
     rows = []
-    variants = VARIANTS + (STUDY if a.study else [])
-    for name, base, folder, fit in scenes():
+    variants = VARIANTS + (CANDIDATES if a.candidates else []) + (STUDY if a.study else [])
+    if a.converge:
+        return converge(a, [s for s in a.converge.split(",") if s], w, h, spp, ref_veil, cache, tmp)
+    for name, base, folder, fit, thick in scenes():
         if wanted and name not in wanted:
             continue
-        for k in ((1.0,) if a.quick else (1.0, a.thick)):
+        for k in ((1.0, a.thick) if thick and not a.quick else (1.0,)):
             scene = absolutise(thicken(base, k), folder)
             label = name if k == 1.0 else "%s x%g" % (name, k)
-            ref_scene = with_ms(scene, None)
-            text = json.dumps(ref_scene, sort_keys=True)
-            ref = os.path.join(cache, reference_key(text, w, h, spp, ref_veil) + ".exr")
-            if not os.path.exists(ref):
-                sp = os.path.join(tmp, "ref.json")
-                with open(sp, "w") as f:
-                    f.write(text)
-                print("reference %s: %dx%d, %d spp ..." % (label, w, h, spp), file=sys.stderr, flush=True)
-                out = run([ref_veil, "reference", sp, "-o", ref + ".part.exr", "--spp", str(spp), "--width", str(w),
-                           "--height", str(h)])
-                os.replace(ref + ".part.exr", ref)
-                print(out.strip().splitlines()[0], file=sys.stderr)
-            for vname, ms in variants:
+            ref = reference(scene, label, w, h, spp, ref_veil, cache, tmp)
+            for vname, ms, quality in variants:
                 if a.quick and vname.startswith("screen "):
                     continue
                 sp = os.path.join(tmp, "v.json")
@@ -181,7 +295,7 @@ def main():
                 frame, turn = [], []
                 for r in range(a.runs):
                     st = stage_ms(run([a.veil, "render", sp, "-o", img, "--width", str(w), "--height", str(h),
-                                       "--stats"]))
+                                       "--quality", quality, "--stats"]))
                     frame.append(sum(st.values()))
                     turn.append(st.get("render", 0.0) + st.get("spread", 0.0))
                 c = json.loads(run([a.veil, "compare", img, ref, "--bin", "4", "--json"]))
@@ -211,7 +325,7 @@ def main():
     print("wrote %s.csv and %s.md" % (base, base), file=sys.stderr)
     try:
         dat = base + ".dat"
-        names = [v for v, _ in variants]
+        names = [v[0] for v in variants]
         with open(dat, "w") as f:
             for v in names:
                 f.write("# %s\n" % v)
