@@ -57,7 +57,7 @@ def optical_depth(c, a, b):
     if k == 0.0:
         return st * rho0 * L
     dy = b[..., 1] - a[..., 1]
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         # integral of exp(-k y) along the segment = L * (exp(-k ya) - exp(-k yb)) / (k dy)
         val = np.where(np.abs(k * dy) > 1e-6, (np.exp(-k * a[..., 1]) - np.exp(-k * b[..., 1])) / (k * dy),
                        np.exp(-k * a[..., 1]))
