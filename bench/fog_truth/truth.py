@@ -1,0 +1,226 @@
+"""Path-traced truth for `veil fog`: Blender Cycles, all orders of scattering.
+
+    blender -b --factory-startup --python truth.py -- CASE FOG SAMPLES SEED OUT.exr
+
+CASE: night | day (scenes.py); FOG: 0 (the surfaces alone: the frame that
+`veil fog` reads), 1 (the same scene inside the case's fog) or 2 (the fog
+with black surfaces: they occlude and absorb but reflect nothing, so the
+picture is the medium's own light from the lights, all orders -- what
+veil's single scattering and volumetric estimate model; 1 minus 2 is the
+light that involves the surfaces, what the frame and its spread model). Writes a
+multilayer EXR (32-bit float) with the passes Combined, Depth (Z along the
+view axis), DiffDir, DiffInd, DiffCol, VolumeDir, VolumeInd.
+
+Calibration to veil (each checked by calibrate.py against a closed form):
+- coordinates: blender (X, Y, Z) = veil (x, -z, y);
+- camera: sensor fit VERTICAL, the same vertical field of view; pixel
+  filter 0.01 px (one ray through each pixel's centre region, as veil's
+  march and the frame's depth are per pixel centre);
+- point light: Power = 4 pi I (Cycles gives a point lamp of power P the
+  intensity P / (4 pi) W/sr), radius 0; sun: Strength = irradiance E
+  (W/m^2), angle 0;
+- medium: Volume Scatter (colour 1, density sigma_s rho, anisotropy g: HG)
+  plus Volume Absorption (colour 0, density sigma_a rho), rho = density *
+  exp(-falloff y) from the world position; the fog is a box = veil's bounds;
+- world black, no clamping, no light threshold, no adaptive sampling, no
+  denoising; 256 bounces of every kind (volume included), so nothing is cut.
+"""
+import math
+import os
+import sys
+
+import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import scenes  # noqa: E402
+
+
+def bl(v):
+    """veil (x, y, z) -> blender (x, -z, y)"""
+    return (v[0], -v[2], v[1])
+
+
+def diffuse_material(name, albedo):
+    m = bpy.data.materials.new(name)
+    m.use_nodes = True
+    nt = m.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    d.inputs["Color"].default_value = (*albedo, 1.0)
+    d.inputs["Roughness"].default_value = 0.0  # Lambert
+    nt.links.new(d.outputs["BSDF"], out.inputs["Surface"])
+    return m
+
+
+def box(name, lo, hi, material):
+    a, b = bl(lo), bl(hi)
+    mn = [min(a[i], b[i]) for i in range(3)]
+    mx = [max(a[i], b[i]) for i in range(3)]
+    centre = [(mn[i] + mx[i]) / 2 for i in range(3)]
+    size = [(mx[i] - mn[i]) for i in range(3)]
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=centre)
+    ob = bpy.context.active_object
+    ob.name = name
+    ob.scale = size
+    bpy.ops.object.transform_apply(location=False, rotation=False, scale=True)  # object scale 1: densities in m^-1
+    ob.data.materials.append(material)
+    return ob
+
+
+def fog_material(c):
+    m = bpy.data.materials.new("fog")
+    m.use_nodes = True
+    nt = m.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    scat = nt.nodes.new("ShaderNodeVolumeScatter")
+    absb = nt.nodes.new("ShaderNodeVolumeAbsorption")
+    add = nt.nodes.new("ShaderNodeAddShader")
+    scat.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    scat.inputs["Anisotropy"].default_value = c["g"]
+    absb.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    ss, sa = c["sigma_s"][0], c["sigma_a"][0]
+    assert c["sigma_s"] == [ss] * 3 and c["sigma_a"] == [sa] * 3, "grey media only"
+    rho0, b = c["fog"]["density"], c["fog"]["falloff"]
+    if b == 0.0:  # constant density: Cycles' homogeneous path (exact distance sampling)
+        scat.inputs["Density"].default_value = ss * rho0
+        absb.inputs["Density"].default_value = sa * rho0
+    else:  # rho = rho0 exp(-b y), y = blender Z of the world position
+        geo = nt.nodes.new("ShaderNodeNewGeometry")
+        sep = nt.nodes.new("ShaderNodeSeparateXYZ")
+        mul = nt.nodes.new("ShaderNodeMath")
+        mul.operation = "MULTIPLY"
+        mul.inputs[1].default_value = -b
+        ex = nt.nodes.new("ShaderNodeMath")
+        ex.operation = "EXPONENT"
+        ks = nt.nodes.new("ShaderNodeMath")
+        ks.operation = "MULTIPLY"
+        ks.inputs[1].default_value = ss * rho0
+        ka = nt.nodes.new("ShaderNodeMath")
+        ka.operation = "MULTIPLY"
+        ka.inputs[1].default_value = sa * rho0
+        nt.links.new(geo.outputs["Position"], sep.inputs[0])
+        nt.links.new(sep.outputs["Z"], mul.inputs[0])
+        nt.links.new(mul.outputs[0], ex.inputs[0])
+        nt.links.new(ex.outputs[0], ks.inputs[0])
+        nt.links.new(ex.outputs[0], ka.inputs[0])
+        nt.links.new(ks.outputs[0], scat.inputs["Density"])
+        nt.links.new(ka.outputs[0], absb.inputs["Density"])
+        # procedural density: Cycles marches with 1/10 of the box's mean size
+        # times this rate (and the scene's rate): 0.1 * 87 m * 0.06 = 0.52 m (b dt = 0.1: the jittered
+        # march's optical depth has a variance far below the noise)
+        m.cycles.volume_step_rate = 0.06
+    nt.links.new(scat.outputs[0], add.inputs[0])
+    nt.links.new(absb.outputs[0], add.inputs[1])
+    nt.links.new(add.outputs[0], out.inputs["Volume"])
+    return m
+
+
+def look_rotation(ob, eye, target, up):
+    from mathutils import Vector
+    d = Vector(target) - Vector(eye)
+    ob.rotation_euler = d.to_track_quat("-Z", "Y").to_euler()
+    # the camera's up: to_track_quat with 'Y' keeps blender's +Z (veil's +y) up
+
+
+def main():
+    argv = sys.argv[sys.argv.index("--") + 1:]
+    if len(argv) != 5:
+        sys.exit("usage: blender -b --factory-startup --python truth.py -- CASE FOG SAMPLES SEED OUT.exr")
+    case, fog, samples, seed, out = argv[0], int(argv[1]), int(argv[2]), int(argv[3]), argv[4]
+    if case not in scenes.CASES:
+        sys.exit("truth.py: unknown case '%s' (expected one of %s)" % (case, ", ".join(scenes.CASES)))
+    c = scenes.CASES[case]
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    sc = bpy.context.scene
+
+    for i, (lo, hi, albedo) in enumerate(scenes.BOXES):
+        box("box%d" % i, lo, hi, diffuse_material("mat%d" % i, (0.0, 0.0, 0.0) if fog == 2 else albedo))
+
+    if fog:
+        lo, hi = scenes.FOG_BOX
+        f = box("fog", lo, hi, fog_material(c))
+        f.data.materials.clear()
+        f.data.materials.append(bpy.data.materials["fog"])
+
+    for i, l in enumerate(c["lights"]):
+        if l["type"] == "point":
+            I = l["intensity"]
+            peak = max(I)
+            ld = bpy.data.lights.new("lamp%d" % i, "POINT")
+            ld.energy = 4.0 * math.pi * peak  # W; Cycles: I = P / (4 pi) W/sr
+            ld.color = tuple(v / peak for v in I)
+            ld.shadow_soft_size = 0.0
+            ob = bpy.data.objects.new("lamp%d" % i, ld)
+            ob.location = bl(l["position"])
+        else:
+            E = l["irradiance"]
+            peak = max(E)
+            ld = bpy.data.lights.new("sun%d" % i, "SUN")
+            ld.energy = peak  # W/m^2
+            ld.color = tuple(v / peak for v in E)
+            ld.angle = 0.0
+            ob = bpy.data.objects.new("sun%d" % i, ld)
+            from mathutils import Vector
+            ob.rotation_euler = Vector(bl(l["direction"])).to_track_quat("-Z", "Y").to_euler()
+        ld.cycles.max_bounces = 1024
+        sc.collection.objects.link(ob)
+
+    cam = scenes.CAMERA
+    cd = bpy.data.cameras.new("cam")
+    cd.sensor_fit = "VERTICAL"
+    cd.angle_y = math.radians(cam["fov_y_deg"])
+    cd.clip_start = 0.01
+    cd.clip_end = 1e4
+    co = bpy.data.objects.new("cam", cd)
+    co.location = bl(cam["position"])
+    look_rotation(co, bl(cam["position"]), bl(cam["look_at"]), bl(cam["up"]))
+    sc.collection.objects.link(co)
+    sc.camera = co
+
+    world = bpy.data.worlds.new("black")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    sc.world = world
+
+    r = sc.render
+    r.engine = "CYCLES"
+    r.resolution_x, r.resolution_y, r.resolution_percentage = cam["width"], cam["height"], 100
+    r.pixel_aspect_x = r.pixel_aspect_y = 1.0
+    r.film_transparent = False
+    r.use_persistent_data = False
+    r.threads_mode = "FIXED"
+    r.threads = 2
+    cy = sc.cycles
+    cy.device = "CPU"
+    cy.samples = samples
+    cy.seed = seed
+    cy.use_adaptive_sampling = False
+    cy.use_denoising = False
+    cy.max_bounces = cy.diffuse_bounces = cy.volume_bounces = 256
+    cy.glossy_bounces = cy.transmission_bounces = cy.transparent_max_bounces = 256
+    cy.sample_clamp_direct = 0.0
+    cy.sample_clamp_indirect = 0.0
+    cy.light_sampling_threshold = 0.0
+    cy.filter_width = 0.01
+    cy.volume_step_rate = 1.0
+    cy.volume_max_steps = 4096
+    cy.caustics_reflective = cy.caustics_refractive = True
+    cy.blur_glossy = 0.0
+    sc.view_settings.view_transform = "Standard"
+
+    vl = sc.view_layers[0]
+    vl.use_pass_combined = True
+    vl.use_pass_z = True
+    vl.use_pass_diffuse_direct = vl.use_pass_diffuse_indirect = vl.use_pass_diffuse_color = True
+    vl.cycles.use_pass_volume_direct = vl.cycles.use_pass_volume_indirect = True
+    im = r.image_settings
+    im.file_format = "OPEN_EXR_MULTILAYER"
+    im.color_depth = "32"
+    im.exr_codec = "ZIP"
+    r.filepath = out
+    bpy.ops.render.render(write_still=True)
+
+
+main()
