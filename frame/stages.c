@@ -541,7 +541,8 @@ static veil_stage_status volumetric_decide(const veil_frame_plan* p, int kept, c
     int dims[3];
     if (!(p->sparse && !cache ? p->grid != NULL : veil_volumetric_grid(&dd, lo, &cell, dims) != 0)) {
         say(w, n, "no grid: no medium, or a fog box over %g m%s", VEIL_DIFFUSION_MAX_EXTENT,
-            escape ? " (the octaves fall back to the legs gate)" : "");
+            escape ? " (the octaves fall back to the legs gate)"
+                   : cache ? " (the march's octaves, gated by the legs, stand in for the light cache)" : "");
         return VEIL_STAGE_SKIPPED;
     }
     if (kept) {
@@ -582,7 +583,8 @@ static veil_result volumetric_build(veil_frame* f, veil_stage_report* rep, veil_
     if (vr.skipped && vr.cache.too_thick) {
         rep->status = VEIL_STAGE_SKIPPED;
         say(rep->why, sizeof rep->why, "no light cache: the medium is too thick for photons (about %.3g steps a "
-            "photon: %d photons would take over %d x the budget's %lld steps); orders >= 2 are left out",
+            "photon: %d photons would take over %d x the budget's %lld steps); the march's octaves, gated by the "
+            "legs, stand in for it",
             vr.cache.steps, VEIL_CACHE_MIN_PHOTONS, VEIL_CACHE_STEPS_PER_PHOTON, d.cache.photons);
     } else if (vr.skipped) { /* decide() found a grid; the module did not: say so rather than hide it */
         rep->status = VEIL_STAGE_SKIPPED;
@@ -629,7 +631,8 @@ static veil_stage_status render_decide(const veil_frame_plan* p, int kept, char*
     const veil_multiple* ms = &p->scene->multiple;
     char multiple[200] = "";
     if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_CACHE)
-        snprintf(multiple, sizeof multiple, ", orders >= 2 from the light cache (stage volumetric)");
+        snprintf(multiple, sizeof multiple,
+                 ", orders >= 2 from the light cache (stage volumetric; where it is not made, the octaves)");
     else if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_DIFFUSION)
         snprintf(multiple, sizeof multiple, ", multiple scattering from the diffusion field (stage volumetric)");
     else if (ms->volumetric && ms->octaves > 1)

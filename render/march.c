@@ -82,7 +82,11 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
         set3(u->diffusion, d->field->tex_min, (float)d->field->kind);
         set3(u->diffusion_inv, d->field->tex_inv, (float)d->field->depth);
     }
-    if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_OCTAVE && ms->octaves > 1) {
+    /* the octaves: asked for, or in place of a light cache that could not be made (a fog box too wide for
+     * its grid, a medium too thick for photons): gated by the legs then (no escape field) */
+    const int no_cache = ms->volumetric_method == VEIL_VOLUMETRIC_CACHE &&
+                         !(d->field && d->field->texture && d->field->kind == VEIL_FIELD_CACHE);
+    if (ms->volumetric && (ms->volumetric_method == VEIL_VOLUMETRIC_OCTAVE || no_cache) && ms->octaves > 1) {
         u->octave[0] = ms->octave_a, u->octave[1] = ms->octave_b, u->octave[2] = ms->octave_c;
         u->octave[3] = (float)ms->octaves;
     }

@@ -64,6 +64,17 @@ n_cached=$(grep -c "^volumetric .*(cached" "$work/log")
 [ "$n_ran" = 1 ] && [ "$n_cached" = 2 ] || fail "turntable: the cache ran $n_ran times, was kept $n_cached times"
 echo "turntable: the cache made once, kept for 2 frames"
 
+# a medium too thick for photons (fog growing as exp(1.2 depth) below its origin, capped at e^60):
+# no cache, said why, and the octaves stand in
+printf '{"camera": {"position": [0, 1.6, 7.5], "look_at": [0, 0.7, 0], "width": 32, "height": 24},
+ "medium": {"sigma_a": [0.02, 0.02, 0.02], "sigma_s": [0.5, 0.55, 0.65], "sources": [{"type": "exponential",
+  "density": 0.35, "falloff": 1.2, "direction": [0, 1, 0], "origin": [0, 0, 0]}]},
+ "lights": [{"type": "directional", "direction": [0.3, -0.8, 0.5], "irradiance": [2, 2, 2]}]}\n' >"$work/thick.json"
+"$veil" render "$work/thick.json" -o "$work/thick.exr" --stats >"$work/log" 2>&1 || fail "thick render: $(head -c 600 "$work/log")"
+grep -q "^volumetric .*skipped: no light cache: the medium is too thick for photons.*octaves, gated by the legs, stand in" \
+    "$work/log" || fail "thick medium: $(grep volumetric "$work/log")"
+echo "a medium too thick for photons: no cache, the octaves stand in"
+
 # emission: a source of the cache, its light in the image
 emission() {
     printf '{"camera": {"position": [0.95, 0.95, 6], "look_at": [0.95, 0.95, 0.45], "fov_y_deg": 30,
