@@ -80,12 +80,15 @@ int veil__cache_grid(const veil_lit_medium* md, int cells, float lo[3], float* h
     for (int a = 0; a < 3; ++a) longest = fmaxf(longest, hi[a] - lo[a]);
     if (!(longest > 0.0f) || !(longest <= VEIL_DIFFUSION_MAX_EXTENT) || cells < 1) return 0;
     *h = longest / (float)cells;
-    for (int a = 0; a < 3; ++a) {
-        dims[a] = (int)ceilf((hi[a] - lo[a]) / *h);
-        if (dims[a] < 1) dims[a] = 1;
-        if (dims[a] > cells) dims[a] = cells;
+    for (;;) {
+        for (int a = 0; a < 3; ++a) {
+            dims[a] = (int)ceilf((hi[a] - lo[a]) / *h);
+            if (dims[a] < 1) dims[a] = 1;
+            if (dims[a] > cells) dims[a] = cells;
+        }
+        if ((double)dims[0] * dims[1] * dims[2] <= VEIL_CACHE_MAX_CELLS) return 1;
+        *h *= 1.25f; /* coarser until the grid fits its memory (a 512^3 ask would be 7.5 GB) */
     }
-    return 1;
 }
 
 /* ---- sources ----------------------------------------------------------- */

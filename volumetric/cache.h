@@ -74,9 +74,14 @@ typedef struct veil_cache_programs {
 veil_result veil__cache_programs(veil_cache_programs* p, int sparse, veil_error* err);
 void veil__cache_programs_free(veil_cache_programs* p);
 
+/* At most this many cells (56 bytes each while built, 32 kept: 235 MB and
+ * 134 MB): a grid that would have more is made coarser until it fits. */
+#define VEIL_CACHE_MAX_CELLS (1 << 22)
+
 /* The grid: its min corner lo, cell edge h and dims, over the EV's box and
  * the fogs' boxes (the EV's alone when they would be wider than
- * VEIL_DIFFUSION_MAX_EXTENT), `cells` along the longest side. 0: none. */
+ * VEIL_DIFFUSION_MAX_EXTENT), `cells` along the longest side (fewer when
+ * that would be over VEIL_CACHE_MAX_CELLS). 0: none. */
 int veil__cache_grid(const veil_lit_medium* md, int cells, float lo[3], float* h, int dims[3]);
 
 /* Builds the cache of md on the grid (lo, h, dims) into a new rgba32f

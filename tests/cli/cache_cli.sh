@@ -75,6 +75,18 @@ grep -q "^volumetric .*skipped: no light cache: the medium is too thick for phot
     "$work/log" || fail "thick medium: $(grep volumetric "$work/log")"
 echo "a medium too thick for photons: no cache, the octaves stand in"
 
+# an absurd grid: 512 cells along a cube's side would be 2^27 cells (7.5 GB); made coarser by 1.25 at a
+# time until under 2^22 cells: 512 / 1.25^6 = 134.2, so 135 cells a side (1.25^5 gives 168^3 = 4.7e6)
+printf '{"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "width": 16, "height": 12},
+ "medium": {"sigma_s": [1, 1, 1], "sources": [{"type": "exponential", "density": 1, "falloff": 0,
+  "direction": [0, 1, 0], "origin": [0, 0, 0], "bounds": [[-1, -1, -1], [1, 1, 1]]}]},
+ "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": [1, 1, 1]}],
+ "multiple_scattering": {"cache_cells": 512, "cache_photons": 4096}}\n' >"$work/big.json"
+"$veil" render "$work/big.json" -o "$work/big.exr" --stats >"$work/log" 2>&1 || fail "big grid: $(head -c 600 "$work/log")"
+grep -q "^volumetric .*the light cache: 4096 photons from 1 source, 135x135x135 cells" "$work/log" ||
+    fail "a 512-cell grid was not made coarser to 135^3: $(grep volumetric "$work/log")"
+echo "cache_cells 512: made coarser, 135^3 cells"
+
 # emission: a source of the cache, its light in the image
 emission() {
     printf '{"camera": {"position": [0.95, 0.95, 6], "look_at": [0.95, 0.95, 0.45], "fov_y_deg": 30,
