@@ -332,17 +332,21 @@ VEIL_STRUCT_END(veil_diffusion_block)
  * against a per-cell majorant; after their first scattering (from their
  * start for the medium's own emission) every piece of path in a cell adds
  * w len / V to the cell's fluence (the track-length estimator) and
- * lum(w) len omega / V to its flux. Sums are signed 64-bit fixed point (two
+ * lum(w) len omega / V to its flux, summed over a photon's visit to the cell
+ * and added once when it leaves. Sums are signed 64-bit fixed point (two
  * uint words, low first) added with integer atomics: order-free, so a seed
  * gives the same cache bit for bit. */
 #define VEIL_CACHE_GROUP 64        /* photons per work group */
 #define VEIL_CACHE_CELL_GROUP 4    /* 4^3 cells per work group (bounds, resolve) */
 #define VEIL_CACHE_SUMS 7          /* per cell: fluence r, g, b; flux x, y, z; the odd photons' luminance fluence */
 #define VEIL_CACHE_WORDS (2 * VEIL_CACHE_SUMS)
-/* A score is at most 2^VEIL_CACHE_FIXED_BITS units (volumetric/cache.c
- * derives the unit from the largest score a photon can make), so one add
- * fits an int32 and 2^33 of them fit a cell's 64 bits. */
-#define VEIL_CACHE_FIXED_BITS 30
+/* A piece of path (at most a cell's diagonal) scores at most
+ * 2^VEIL_CACHE_FIXED_BITS units (volumetric/cache.c derives the unit from
+ * the largest score a photon can make); a visit is added before it holds
+ * more than VEIL_CACHE_VISIT_DIAGONALS diagonals of path, so one add is at
+ * most 2^30 units and fits an int32, and 2^33 adds fit a cell's 64 bits. */
+#define VEIL_CACHE_FIXED_BITS 20
+#define VEIL_CACHE_VISIT_DIAGONALS 1024
 /* SSBO bindings of the cache's own passes (GL guarantees 8: 0..7) */
 #define VEIL_BIND_CACHE_SUM 0      /* uint[cells * VEIL_CACHE_WORDS] */
 #define VEIL_BIND_CACHE_CELL 1     /* vec2[cells]: majorant density, emission weight */

@@ -26,13 +26,16 @@
  * its fluence (the track-length estimator: E[sum of l] over photons is the
  * fluence times V) and lum(w) l omega / V to its flux.
  *
- * The fixed point: every score is at most s_max = 3 Phi_max sqrt(3) h / V
- * (a photon's channel weights sum to at most 3 Phi_max and never grow,
- * cache_trace.comp; a piece is at most a cell's diagonal), so with
- * 2^VEIL_CACHE_FIXED_BITS units to s_max one add is an int32 and a cell's
- * signed 64-bit sum holds 2^33 adds. Each add is floor(s u + xi): unbiased,
- * within one unit (s_max 2^-30) of s; the noise it adds is below 1/2 unit
- * per add in standard deviation, ~1e-9 of a score.
+ * The fixed point: a piece of path scores at most s_max = 3 Phi_max
+ * sqrt(3) h / V (a photon's channel weights sum to at most 3 Phi_max and
+ * never grow, cache_trace.comp; a piece is at most a cell's diagonal); a
+ * photon's visit to a cell is added once, before it holds more than
+ * VEIL_CACHE_VISIT_DIAGONALS (2^10) diagonals of path. With
+ * 2^VEIL_CACHE_FIXED_BITS (2^20) units to s_max, one add is at most 2^30
+ * units, an int32, and a cell's signed 64-bit sum holds 2^33 adds. Each add
+ * is floor(s u + xi): unbiased, within one unit (s_max 2^-20) of s; the
+ * noise it adds is below 1/2 unit per add in standard deviation, ~5e-7 of a
+ * piece's largest score.
  */
 #ifndef VEIL_CACHE_H
 #define VEIL_CACHE_H

@@ -56,21 +56,46 @@ void add64(uint k, int v)
     if (hi != 0u) atomicAdd(sums[k + 1u], hi);
 }
 
-// A piece of path of length len in cell c, weights w, travelling along d.
-void score(ivec3 c, vec3 w, vec3 d, float len, bool odd)
+// The photon's visit to one cell so far: its pieces' w len (rgb) and
+// lum(w) len d, added to the cell's sums once, when it leaves the cell
+// (or ends): a photon that collides many times in a cell pays one set of
+// atomics for the visit, not one a piece.
+vec3 visit_phi, visit_flux;
+float visit_len;
+bool visit_any;
+
+// The visit's sums into cell c (in units: W/m^2 times the fixed point's units per W/m^2).
+void flush(ivec3 c, bool odd)
 {
+    if (!visit_any) return;
     uint k = (uint(c.x) + uint(cb.dims.x) * (uint(c.y) + uint(cb.dims.y) * uint(c.z))) * uint(VEIL_CACHE_WORDS);
-    float u = len * cb.scale.z * cb.scale.x; // units per W of weight
+    float u = cb.scale.z * cb.scale.x; // units per W m of weight times length
     float xi = rnd();
-    float wl = dot(w, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B));
-    add64(k + 0u, veil_cache_fixed(w.r * u, xi));
-    add64(k + 2u, veil_cache_fixed(w.g * u, xi));
-    add64(k + 4u, veil_cache_fixed(w.b * u, xi));
-    add64(k + 6u, veil_cache_fixed(wl * u * d.x, xi));
-    add64(k + 8u, veil_cache_fixed(wl * u * d.y, xi));
-    add64(k + 10u, veil_cache_fixed(wl * u * d.z, xi));
-    if (odd) add64(k + 12u, veil_cache_fixed(wl * u, xi));
-    if (max(w.r, max(w.g, w.b)) * u > float(1 << VEIL_CACHE_FIXED_BITS)) atomicAdd(counts[1], 1u);
+    vec3 p = visit_phi * u, f = visit_flux * u;
+    add64(k + 0u, veil_cache_fixed(p.r, xi));
+    add64(k + 2u, veil_cache_fixed(p.g, xi));
+    add64(k + 4u, veil_cache_fixed(p.b, xi));
+    add64(k + 6u, veil_cache_fixed(f.x, xi));
+    add64(k + 8u, veil_cache_fixed(f.y, xi));
+    add64(k + 10u, veil_cache_fixed(f.z, xi));
+    if (odd) add64(k + 12u, veil_cache_fixed(dot(p, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B)), xi));
+    if (max(p.r, max(p.g, p.b)) > float(VEIL_CACHE_VISIT_DIAGONALS << VEIL_CACHE_FIXED_BITS))
+        atomicAdd(counts[1], 1u);
+    visit_phi = vec3(0.0), visit_flux = vec3(0.0);
+    visit_len = 0.0;
+    visit_any = false;
+}
+
+// A piece of path of length len in cell c, weights w, along d: added to the
+// visit, which is flushed before it holds more than VEIL_CACHE_VISIT_DIAGONALS
+// cell diagonals of path (the fixed point's headroom).
+void visit(ivec3 c, vec3 w, vec3 d, float len, bool odd)
+{
+    if (visit_len + len > float(VEIL_CACHE_VISIT_DIAGONALS) * 1.7320508 * cb.origin.w) flush(c, odd);
+    visit_phi += w * len;
+    visit_flux += dot(w, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B)) * len * d;
+    visit_len += len;
+    visit_any = true;
 }
 
 // A unit vector at cos_t from axis a, azimuth phi.
@@ -138,6 +163,9 @@ void main()
     float g = cb.sigma_s.w;
     int steps = 0;
     const int cap = int(cb.seed.z);
+    visit_phi = vec3(0.0), visit_flux = vec3(0.0);
+    visit_len = 0.0;
+    visit_any = false;
     for (; steps < cap; ++steps) {
         // where the path leaves cell c
         vec3 lo = cb.origin.xyz + vec3(c) * h;
@@ -150,7 +178,8 @@ void main()
         float maj = cells[k].x * cb.scale.w;
         if (maj > 0.0) maj = max(maj, cb.sigma_a.w);
         if (maj * t_exit <= tau) { // no collision in the cell: on to the next
-            if (scored) score(c, w, dir, t_exit, odd);
+            if (scored) visit(c, w, dir, t_exit, odd);
+            flush(c, odd);
             tau -= maj * t_exit;
             pos += dir * t_exit;
             c[axis] += step_dir[axis];
@@ -158,7 +187,7 @@ void main()
             continue;
         }
         float t = tau / maj;
-        if (scored) score(c, w, dir, t, odd);
+        if (scored) visit(c, w, dir, t, odd);
         pos += dir * t;
         // a tentative collision: absorbed, scattered or null
         float rho = cache_density(pos);
@@ -167,7 +196,7 @@ void main()
         float sw = maj * (w.r + w.g + w.b);
         float p_s = dot(w, s_s) / sw, p_a = dot(w, s_a) / sw, p_n = dot(w, s_n) / sw;
         float xi = rnd() * (p_s + p_a + p_n); // their sum is 1 but for rounding
-        if (xi < p_a) break;
+        if (xi < p_a) break; // absorbed (the visit so far is flushed below)
         if (xi < p_a + p_s) {
             w *= s_s / (maj * p_s);
             dir = scatter_hg(dir, g);
@@ -178,5 +207,6 @@ void main()
         }
         tau = -log(1.0 - rnd());
     }
+    flush(c, odd); // the last visit: absorbed, or cut (a path that left the grid has flushed already)
     if (steps == cap) atomicAdd(counts[0], 1u);
 }
