@@ -6,7 +6,7 @@ all-orders path tracer (`veil reference --max-order 0`).
 
     python3 bench/multiple_scattering.py [--quick] [--size WxH] [--spp N]
         [--runs R] [--scenes a,b,...] [--candidates] [--study] [--veil build/veil]
-    python3 bench/multiple_scattering.py --converge "demo,cumulus, sun behind" [--size WxH] [--spp N]
+    python3 bench/multiple_scattering.py --converge "demo;dense fog, lamp inside" [--size WxH] [--spp N]
 
 --converge: the cache's error against its budget (photons doubling, then
 cells), into docs/results/cache_convergence.{md,dat,png}.
@@ -31,7 +31,7 @@ image size, spp and the bytes of the veil binary that renders them
 Results: docs/results/multiple_scattering.{csv,md} (and .png with gnuplot).
 Python 3 standard library only.
 """
-import argparse, hashlib, json, os, statistics, subprocess, sys, tempfile
+import argparse, csv, hashlib, json, os, statistics, subprocess, sys, tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHARED = os.path.join(os.path.dirname(ROOT), "shared", "data")
@@ -261,7 +261,7 @@ def main():
     ap.add_argument("--scenes", default="")
     ap.add_argument("--study", action="store_true")
     ap.add_argument("--candidates", action="store_true", help="also the earlier candidates (screen, legs, diffusion)")
-    ap.add_argument("--converge", default="", help="scenes (comma-separated): the cache's error against its budget")
+    ap.add_argument("--converge", default="", help="scenes (semicolon-separated: names hold commas): the cache's error against its budget")
     ap.add_argument("--veil", default=os.path.join(ROOT, "build", "veil"))
     ap.add_argument("--ref-veil", default="", help="the veil that renders the references (default: --veil)")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "results"))
@@ -277,7 +277,7 @@ def main():
     rows = []
     variants = VARIANTS + (CANDIDATES if a.candidates else []) + (STUDY if a.study else [])
     if a.converge:
-        return converge(a, [s for s in a.converge.split(",") if s], w, h, spp, ref_veil, cache, tmp)
+        return converge(a, [s for s in a.converge.split(";") if s], w, h, spp, ref_veil, cache, tmp)
     for name, base, folder, fit, thick in scenes():
         if wanted and name not in wanted:
             continue
@@ -311,10 +311,11 @@ def main():
         sys.exit("no scene ran")
     base = os.path.join(a.out, "multiple_scattering" + ("-quick" if a.quick else ""))
     keys = list(rows[0].keys())
-    with open(base + ".csv", "w") as f:
-        f.write(",".join(keys) + "\n")
+    with open(base + ".csv", "w", newline="") as f:  # scene names hold commas: quoted where they do
+        wr = csv.writer(f)
+        wr.writerow(keys)
         for r in rows:
-            f.write(",".join(str(r[k]) for k in keys) + "\n")
+            wr.writerow([r[k] for k in keys])
     with open(base + ".md", "w") as f:
         f.write("| scene | fitted on | variant | still frame (ms) | turntable frame (ms) | rel. RMSE 4x4, noise out | "
                 "mean bias | ref. noise 4x4 |\n|---|---|---|---:|---:|---:|---:|---:|\n")
