@@ -351,7 +351,7 @@ VEIL_STRUCT_END(veil_diffusion_block)
 #define VEIL_BIND_CACHE_SUM 0      /* uint[cells * VEIL_CACHE_WORDS] */
 #define VEIL_BIND_CACHE_CELL 1     /* vec2[cells]: majorant density, emission weight */
 #define VEIL_BIND_CACHE_EMIT 2     /* the emitting cells: uvec2 (cell, the CDF up to it as float bits) */
-#define VEIL_BIND_CACHE_COUNT 3    /* uint[4]: photons cut at the step cap, scores clamped, -, - */
+#define VEIL_BIND_CACHE_COUNT 3    /* uint[4]: photons cut at the step cap, scores clamped, majorant misses, - */
 #define VEIL_UBO_CACHE 7
 /* The cache is one rgba32f texture of two stacked grids (cells nx, ny, 2 nz): z in [0, nz) the fluence rgb
  * with the odd photons' luminance fluence in a, z in [nz, 2 nz) the luminance-weighted flux xyz. One

@@ -397,6 +397,11 @@ static veil_result volumetric_build(veil_frame* f, veil_stage_report* rep, veil_
             snprintf(rep->why + len, sizeof rep->why - len, "; %lld photons asked for, fewer in a medium this thick "
                      "(about %.0f steps a photon)", c->asked, c->steps);
         }
+        if (c->misses) {
+            size_t len = strlen(rep->why);
+            snprintf(rep->why + len, sizeof rep->why - len, "; %u densities above their cell's majorant (a bug)",
+                     c->misses);
+        }
         if (c->cut || c->clamped) {
             size_t len = strlen(rep->why);
             snprintf(rep->why + len, sizeof rep->why - len, "; %u photons cut at %d steps, %u scores clamped",

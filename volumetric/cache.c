@@ -412,7 +412,7 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     uint32_t counts[4];
     glGetNamedBufferSubData(buf[3], 0, sizeof counts, counts);
-    rep->cut = counts[0], rep->clamped = counts[1];
+    rep->cut = counts[0], rep->clamped = counts[1], rep->misses = counts[2];
 
     /* 5. the noise: odd photons against even ones, E (o - e)^2 = Var(o + e) per cell */
     free(cellv);

@@ -63,6 +63,7 @@ typedef struct veil_cache_report {
     double noise;          /* the cells' relative noise, fluence-weighted RMS (odd against even photons) */
     double bytes;          /* device memory while it is built (sums, majorants, the two fields) */
     unsigned cut, clamped; /* photons cut at `cap` steps; scores over the fixed point's bound */
+    unsigned misses;       /* tentative collisions where the density was above the cell's majorant (a bug if not 0) */
     int cap;               /* a photon's step cap */
     double steps;          /* the steps a photon takes, as estimated from the cells' majorants */
     long long asked;       /* the photons the budget asked for (more than `photons`: the medium is thick) */

@@ -191,6 +191,7 @@ void main()
         pos += dir * t;
         // a tentative collision: absorbed, scattered or null
         float rho = cache_density(pos);
+        if (rho * cb.scale.w > maj * 1.0001) atomicAdd(counts[2], 1u); // a majorant that is not one (a bug)
         vec3 s_s = rho * cb.sigma_s.rgb, s_a = rho * cb.sigma_a.rgb;
         vec3 s_n = max(vec3(maj) - s_s - s_a, vec3(0.0));
         float sw = maj * (w.r + w.g + w.b);
