@@ -32,8 +32,7 @@
  *    and errors >= 0, alpha in [0, 1]; its cut walks and dropped samples are
  *    counted and printed.
  * A scene the library rejects with an error is counted (and its message
- * shown); more than 5 % rejected means the generator makes invalid scenes.
- * Multiple scattering is the default (the light cache), on a small budget.
+ * shown); more than 5 % rejected means the generator makes invalid scenes. The light cache: 4096 photons.
  *   test_stress [SCENES [SEED [FIRST]]]   (default 500 scenes, seed 3, from scene 0)
  * Scene i draws from its own stream (SEED, i): `test_stress 1 SEED i` redoes it alone. */
 #include <float.h>
@@ -364,8 +363,7 @@ static void gen_scene_json(sbuf* b, gen_scene* g)
     sb_add(b, "], ");
     gen_camera(b, g);
     colour(bg, 1e-2, 1e1, 1.0, 0.3);
-    /* the light cache on a small budget (its guard against thick media and its bounds are what is
-     * stressed, not its noise): 4096 photons, 8 cells */
+    /* the light cache on a small budget: its guards and bounds are stressed, not its noise */
     sb_add(b, ", \"background\": {\"color\": " VF "}, \"multiple_scattering\": {\"cache_photons\": 4096, "
               "\"cache_cells\": 8}}", V3(bg));
 }
