@@ -351,7 +351,26 @@ VEIL_STRUCT_END(veil_diffusion_block)
 #define VEIL_BIND_CACHE_SUM 0      /* uint[cells * VEIL_CACHE_WORDS] */
 #define VEIL_BIND_CACHE_CELL 1     /* vec2[cells]: majorant density, emission weight */
 #define VEIL_BIND_CACHE_EMIT 2     /* the emitting cells: uvec2 (cell, the CDF up to it as float bits) */
-#define VEIL_BIND_CACHE_COUNT 3    /* uint[4]: photons cut at the step cap, scores clamped, majorant misses, - */
+#define VEIL_BIND_CACHE_COUNT 3    /* uint[4]: photons cut at the step cap, scores clamped, majorant misses, -;
+                                      then the energy account's int64 sums (below) */
+/* The energy account of the light that scattered (or was emitted): per
+ * group of photons (photon n in group n mod VEIL_CACHE_ENERGY_GROUPS, for a
+ * standard error), per channel, the weight that entered (at its first
+ * scattering; emission at its start), left the grid, was absorbed, and the
+ * collision estimator sum over tentative collisions of w sigma_t / sigma_bar
+ * (whose mean is the integral of sigma_t phi) and the track length sum of
+ * w len (whose mean is the integral of phi: the cells' fluence times their
+ * volume). Units: power.w per W (a photon's channel weight is at most 2^20
+ * units); the collision sum 2^-16 of that, as a photon makes at most 2^16
+ * tentative collisions; the track length 2^-16 / (sqrt(3) h) of it per W m. */
+#define VEIL_CACHE_ENERGY_GROUPS 8
+#define VEIL_CACHE_ENERGY_IN 0
+#define VEIL_CACHE_ENERGY_OUT 1
+#define VEIL_CACHE_ENERGY_ABSORBED 2
+#define VEIL_CACHE_ENERGY_COLLISIONS 3
+#define VEIL_CACHE_ENERGY_TRACK 4
+#define VEIL_CACHE_ENERGY_KINDS 5
+#define VEIL_CACHE_ENERGY_WORDS (2 * 3 * VEIL_CACHE_ENERGY_KINDS * VEIL_CACHE_ENERGY_GROUPS)
 #define VEIL_UBO_CACHE 7
 /* The cache is one rgba32f texture of two stacked grids (cells nx, ny, 2 nz): z in [0, nz) the fluence rgb
  * with the odd photons' luminance fluence in a, z in [nz, 2 nz) the luminance-weighted flux xyz. One
@@ -384,7 +403,7 @@ VEIL_STRUCT_BEGIN(veil_cache_block)
     VEIL_UV4(source);  /* x: VEIL_CACHE_*, y: the light, z: the first photon of this dispatch, w: photons of the source */
     VEIL_UV4(seed);    /* x: the seed, y: the source's index among the cache's, z: a photon's step cap, w: - */
     VEIL_V4(power);    /* rgb: W per photon (sun, cone: before a spot's falloff; emission: W per photon per
-                          (W m^-3 sr^-1 of emission, 1 / p of the cell)), w: - */
+                          (W m^-3 sr^-1 of emission, 1 / p of the cell)), w: the energy account's units per W */
     VEIL_V4(src0);     /* sun: a corner of the rectangle photons start on; cone: the apex (m) */
     VEIL_V4(src1);     /* sun: the rectangle's first edge (m); cone: the axis (unit), w: cos of the half-angle */
     VEIL_V4(src2);     /* sun: the second edge (m); w: - */

@@ -392,6 +392,19 @@ static veil_result volumetric_build(veil_frame* f, veil_stage_report* rep, veil_
             100.0 * c->noise, c->bytes / 1048576.0,
             (double)c->dims[0] * c->dims[1] * c->dims[2] * 32.0 / 1048576.0,
             c->cut || c->clamped ? "" : "");
+        double e_in = VEIL_LUM_R * c->energy[VEIL_CACHE_ENERGY_IN][0] + VEIL_LUM_G * c->energy[VEIL_CACHE_ENERGY_IN][1] +
+                      VEIL_LUM_B * c->energy[VEIL_CACHE_ENERGY_IN][2];
+        if (e_in > 0.0) { /* the energy account: what scattered leaves or is absorbed (cut photons aside) */
+            double out = 0.0, ab = 0.0;
+            for (int k = 0; k < 3; ++k) {
+                double l = k == 0 ? VEIL_LUM_R : (k == 1 ? VEIL_LUM_G : VEIL_LUM_B);
+                out += l * c->energy[VEIL_CACHE_ENERGY_OUT][k];
+                ab += l * c->energy[VEIL_CACHE_ENERGY_ABSORBED][k];
+            }
+            size_t len = strlen(rep->why);
+            snprintf(rep->why + len, sizeof rep->why - len, "; of the light that scattered, %.1f %% left the grid, "
+                     "%.1f %% was absorbed", 100.0 * out / e_in, 100.0 * ab / e_in);
+        }
         if (c->asked > c->photons) {
             size_t len = strlen(rep->why);
             snprintf(rep->why + len, sizeof rep->why - len, "; %lld photons asked for, fewer in a medium this thick "

@@ -242,7 +242,8 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     if (r == VEIL_OK)
         r = veil_gl_buffer(NULL, cells * 2 * sizeof(float), GL_DYNAMIC_STORAGE_BIT, "veil cache cells", &buf[1], err);
     if (r == VEIL_OK)
-        r = veil_gl_buffer(NULL, 4 * sizeof(uint32_t), GL_DYNAMIC_STORAGE_BIT, "veil cache counts", &buf[3], err);
+        r = veil_gl_buffer(NULL, (4 + VEIL_CACHE_ENERGY_WORDS) * sizeof(uint32_t), GL_DYNAMIC_STORAGE_BIT,
+                           "veil cache counts", &buf[3], err);
     const int stacked[3] = {dims[0], dims[1], 2 * dims[2]};
     if (r == VEIL_OK) r = field_texture(stacked, "veil light cache (fluence, flux)", tex, err);
     if (r != VEIL_OK) goto done;
@@ -380,6 +381,8 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     double units = s_max > 0.0 ? ldexp(1.0, VEIL_CACHE_FIXED_BITS) / s_max : 1.0;
     b.scale[0] = (float)units;
     b.scale[1] = (float)(1.0 / units);
+    /* the energy account: a photon's channel weight is at most 3 phi_max, 2^VEIL_CACHE_FIXED_BITS units */
+    const double units_e = phi_max > 0.0 ? ldexp(1.0, VEIL_CACHE_FIXED_BITS) / (3.0 * phi_max) : 1.0;
     glUseProgram(p->trace[sparse]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_CACHE_EMIT, buf[2]);
     for (int j = 0; j < n_src; ++j) {
@@ -393,6 +396,7 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
             b.power[c] = (float)(o->power[c] / (double)src[j].photons);
             b.src0[c] = o->src0[c], b.src1[c] = o->src1[c], b.src2[c] = o->src2[c], b.src3[c] = o->src3[c];
         }
+        b.power[3] = (float)units_e;
         for (long long first = 0; first < src[j].photons; first += CACHE_DISPATCH_PHOTONS) {
             long long n = src[j].photons - first < CACHE_DISPATCH_PHOTONS ? src[j].photons - first
                                                                           : CACHE_DISPATCH_PHOTONS;
@@ -410,9 +414,20 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     glDispatchCompute(veil_groups(dims[0], VEIL_CACHE_CELL_GROUP), veil_groups(dims[1], VEIL_CACHE_CELL_GROUP),
                       veil_groups(dims[2], VEIL_CACHE_CELL_GROUP));
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    uint32_t counts[4];
+    uint32_t counts[4 + VEIL_CACHE_ENERGY_WORDS];
     glGetNamedBufferSubData(buf[3], 0, sizeof counts, counts);
     rep->cut = counts[0], rep->clamped = counts[1], rep->misses = counts[2];
+    for (int g = 0; g < VEIL_CACHE_ENERGY_GROUPS; ++g)
+        for (int q = 0; q < VEIL_CACHE_ENERGY_KINDS; ++q)
+            for (int c = 0; c < 3; ++c) {
+                const uint32_t* w = &counts[4 + 2 * (3 * (VEIL_CACHE_ENERGY_KINDS * g + q) + c)];
+                int64_t v = (int64_t)(((uint64_t)w[1] << 32) | w[0]);
+                double watts = (double)v / units_e *
+                               (q == VEIL_CACHE_ENERGY_COLLISIONS ? 65536.0
+                                                                  : (q == VEIL_CACHE_ENERGY_TRACK ? 65536.0 * sqrt(3.0) * h : 1.0));
+                rep->energy_groups[g][q][c] = watts;
+                rep->energy[q][c] += watts;
+            }
 
     /* 5. the noise: odd photons against even ones, E (o - e)^2 = Var(o + e) per cell */
     free(cellv);

@@ -68,6 +68,13 @@ typedef struct veil_cache_report {
     double steps;          /* the steps a photon takes, as estimated from the cells' majorants */
     long long asked;       /* the photons the budget asked for (more than `photons`: the medium is thick) */
     int too_thick;         /* 1: no cache (*tex 0): even VEIL_CACHE_MIN_PHOTONS would take over the budget */
+    /* The energy account (core/shared.glsl.h), W per channel: [VEIL_CACHE_ENERGY_IN] the light that
+     * scattered (or was emitted), [_OUT] what of it left the grid, [_ABSORBED] what was absorbed,
+     * [_COLLISIONS] the collision estimator of the integral of sigma_t phi (W), [_TRACK] the track length
+     * sum, the integral of phi (W m: the cells' fluence times their volume, summed); in all and per group
+     * of photons (photon n in group n mod VEIL_CACHE_ENERGY_GROUPS). Photons cut at `cap` are left out. */
+    double energy[VEIL_CACHE_ENERGY_KINDS][3];
+    double energy_groups[VEIL_CACHE_ENERGY_GROUPS][VEIL_CACHE_ENERGY_KINDS][3];
 } veil_cache_report;
 
 /* Programs of the cache's passes (dense, and sparse made when first needed). */

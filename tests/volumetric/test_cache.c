@@ -23,7 +23,24 @@
  *    cell means is off by at most that change, half of it on a mean over
  *    a ray (the linear part cancels). Counting order 1 twice would add the
  *    single scattering's mean, which the test first checks is far above
- *    that bound. */
+ *    that bound.
+ * 4. Energy, in a closed case: a fog box of albedo 1 (no absorption,
+ *    chromatic sigma_s, HG g 0.85) under a sun straight down. The cache's
+ *    energy account (core/shared.glsl.h) must show what enters the medium
+ *    leave it: the light that scattered, E A (1 - exp(-sigma_s L)) per
+ *    channel in closed form (A the box's top, L its height), all of it
+ *    leaving the grid and none absorbed. With absorption, what scattered =
+ *    what left + what was absorbed. And the fluence the march reads holds
+ *    the photons' track length (its cells times their volume), whose sigma_t
+ *    times it the collision estimator measures independently. Tolerances:
+ *    from the spread of the 8 groups of photons (photon n in group n mod 8),
+ *    a sum's standard error sqrt(8 s^2) with s^2 the groups' sample
+ *    variance (7 degrees of freedom: |t| > 5.41 has probability 1e-3), so
+ *    5.5 standard errors; a photon's channel weights sum to a constant
+ *    (cache_trace.comp), so albedo 1 conserves each photon's sum exactly
+ *    but for the fixed point's rounding, |e| < 1 unit per add, unbiased and
+ *    independent: by Hoeffding, over 2 N adds of range 2 units the sum's
+ *    error exceeds 2 sqrt(2 N ln(2 / 1e-9)) units with probability 1e-9. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -129,6 +146,105 @@ static void determinism(veil_volumetric* d)
     for (int i = 0; i < 3; ++i) free(out[i]);
 }
 
+/* The sum over groups of one kind and channel, and its standard error from the groups' spread; with
+ * `minus` (a kind, or -1) and factor k, of the paired difference kind - k minus. */
+static double group_sum(const veil_cache_report* c, int kind, int minus, double k, int ch, double* se)
+{
+    const int G = VEIL_CACHE_ENERGY_GROUPS;
+    double v[VEIL_CACHE_ENERGY_GROUPS], mean = 0.0, ss = 0.0;
+    for (int g = 0; g < G; ++g) {
+        v[g] = c->energy_groups[g][kind][ch] - (minus >= 0 ? k * c->energy_groups[g][minus][ch] : 0.0);
+        mean += v[g] / G;
+    }
+    for (int g = 0; g < G; ++g) ss += (v[g] - mean) * (v[g] - mean);
+    *se = sqrt(G * ss / (G - 1));
+    return mean * G;
+}
+
+static void energy(veil_volumetric* d)
+{
+    veil_error err = {0};
+    veil_source fog = fog_box();
+    veil_light sun = {.type = VEIL_LIGHT_DIRECTIONAL, .direction = {0.0f, -1.0f, 0.0f}, .color = {1.0f, 2.0f, 3.0f}};
+    const float sigma_s[3] = {1.0f, 0.6f, 0.3f}, sigma_a[3] = {0.25f, 0.1f, 0.4f}; /* both chromatic */
+    for (int absorbing = 0; absorbing < 2; ++absorbing) {
+        veil_scene s = {0};
+        for (int c = 0; c < 3; ++c) s.medium.sigma_s[c] = sigma_s[c], s.medium.sigma_a[c] = absorbing ? sigma_a[c] : 0.0f;
+        s.medium.phase = (veil_phase){.type = VEIL_PHASE_HG, .g = 0.85f};
+        s.medium.sources = &fog;
+        s.medium.source_count = 1;
+        veil_multiple_defaults(&s.multiple);
+        GLuint opv[VEIL_MAX_OPV_TEXTURES] = {0};
+        veil_volumetric_desc vd = {.kind = VEIL_FIELD_CACHE,
+                                   .medium = {.scene = &s, .lights = &sun, .light_count = 1, .opv = opv},
+                                   .cache = {.photons = 1 << 18, .cells = 12, .seed = 11}};
+        veil_volumetric_field f;
+        veil_volumetric_report rep;
+        CHECK(veil_volumetric_update(d, &vd, 300 + (uint64_t)absorbing, &f, &rep, &err) == VEIL_OK, "%s", err.msg);
+        const veil_cache_report* c = &rep.cache;
+        CHECK(c->cut == 0 && c->misses == 0, "energy: %u photons cut, %u majorant misses", c->cut, c->misses);
+        int dims[3] = {0, 0, 0};
+        float* phi = veil_volumetric_readback(d, dims);
+        CHECK(phi != NULL && dims[0] == 12 && dims[1] == 12 && dims[2] == 12, "the cache read back (%dx%dx%d)",
+              dims[0], dims[1], dims[2]);
+        const double A = 4.0, L = 2.0, V = pow(2.0 / 12.0, 3.0);
+        double sum_in = 0.0, sum_out = 0.0;
+        for (int ch = 0; ch < 3; ++ch) {
+            double st = (double)s.medium.sigma_s[ch] + s.medium.sigma_a[ch], se;
+            double want = sun.color[ch] * A * (s.medium.sigma_s[ch] / st) * (1.0 - exp(-st * L));
+            double in = group_sum(c, VEIL_CACHE_ENERGY_IN, -1, 0.0, ch, &se);
+            CHECK(fabs(in - want) <= 5.5 * se, "channel %d: scattered %.6g W, closed form %.6g (5.5 se %.3g)", ch, in,
+                  want, 5.5 * se);
+            /* what scattered = what left + what was absorbed: the paired difference */
+            double out = c->energy[VEIL_CACHE_ENERGY_OUT][ch], ab = c->energy[VEIL_CACHE_ENERGY_ABSORBED][ch];
+            double bal = group_sum(c, VEIL_CACHE_ENERGY_IN, VEIL_CACHE_ENERGY_OUT, 1.0, ch, &se) - ab;
+            double se_ab;
+            group_sum(c, VEIL_CACHE_ENERGY_ABSORBED, -1, 0.0, ch, &se_ab);
+            double tol = 5.5 * sqrt(se * se + se_ab * se_ab); /* the two sums' errors: at most the root of the sum */
+            CHECK(fabs(bal) <= tol, "channel %d: scattered %.6g W, left %.6g + absorbed %.6g: off by %.3g > %.3g", ch,
+                  in, out, ab, bal, tol);
+            if (absorbing)
+                CHECK(ab > 0.1 * in, "channel %d: absorbed %.4g of %.4g W (albedo %.2f)", ch, ab, in,
+                      s.medium.sigma_s[ch] / st);
+            else
+                CHECK(ab == 0.0, "channel %d: %.4g W absorbed at albedo 1", ch, ab);
+            /* the fluence's cells hold the track length; sigma_t times it is what the collisions measure */
+            double cells = 0.0;
+            for (size_t k = 0; phi && k < 12 * 12 * 12; ++k) cells += phi[4 * k + ch] * V;
+            double track = c->energy[VEIL_CACHE_ENERGY_TRACK][ch];
+            /* the same pieces of path, rounded apart: Hoeffding over the adds (the cells': at most a visit a
+             * step, cap + 1 a photon; the account's: one a photon), each within one unit, unbiased; the
+             * texture's float (2^-24 relative a cell) on top */
+            double phi_max = 3.0 * A / (double)c->photons, h = 2.0 / 12.0;
+            double unit_cells = 3.0 * phi_max * sqrt(3.0) * h / 1048576.0, unit_acc = 65536.0 * unit_cells;
+            double n_cells = (double)c->photons * (c->cap + 1.0), n_acc = (double)c->photons;
+            double tol_t = 2.0 * sqrt(2.0 * log(2.0 / 1e-9)) * (sqrt(n_cells) * unit_cells + sqrt(n_acc) * unit_acc) +
+                           1728.0 * 6e-8 * track;
+            CHECK(fabs(cells - track) <= tol_t, "channel %d: the cells' fluence times volume %.9g W m, the photons' "
+                  "track length %.9g: off by %.3g > %.3g", ch, cells, track, cells - track, tol_t);
+            double coll = group_sum(c, VEIL_CACHE_ENERGY_COLLISIONS, VEIL_CACHE_ENERGY_TRACK, st, ch, &se);
+            CHECK(fabs(coll) <= 5.5 * se, "channel %d: collision estimator - sigma_t x track length = %.4g "
+                  "(5.5 se %.3g; track %.6g W m)", ch, coll, 5.5 * se, track);
+            sum_in += in, sum_out += out;
+            printf("energy (%s) channel %d: scattered %.5g W (closed form %.5g), left %.5g, absorbed %.4g; track "
+                   "%.8g W m, cells %.8g (bound %.2g)\n", absorbing ? "absorbing" : "albedo 1", ch, in, want, out,
+                   ab, track, cells, tol_t);
+        }
+        if (!absorbing) {
+            /* each photon's channel sum is kept exactly: only the rounding separates in from out. Units of the
+             * account: a photon's channel weight <= 3 phi_max = 2^20 units, phi_max the largest channel of
+             * a photon's power, here E_max A / N */
+            double unit = 3.0 * 3.0 * A / (double)c->photons / 1048576.0;
+            double adds = 2.0 * 3.0 * (double)c->photons;
+            double bound = 2.0 * sqrt(2.0 * adds * log(2.0 / 1e-9)) * unit;
+            CHECK(fabs(sum_out - sum_in) <= bound, "albedo 1: the channels' sum %.9g W in, %.9g out: off by %.3g > "
+                  "%.3g (the fixed point's rounding)", sum_in, sum_out, sum_out - sum_in, bound);
+            printf("energy: albedo 1, %.9g W scattered, %.9g W left (rounding bound %.2g)\n", sum_in, sum_out, bound);
+        }
+        free(phi);
+    }
+}
+
 static double image_mean(const float* rgba, int n, int stride)
 {
     double sum = 0.0;
@@ -211,6 +327,7 @@ int main(void)
     veil_volumetric* d = NULL;
     CHECK(veil_volumetric_create(&d, &err) == VEIL_OK, "%s", err.msg);
     if (d) determinism(d);
+    if (d) energy(d);
     veil_volumetric_destroy(d);
     no_double_count(gl);
     veil_gl_destroy(gl);

@@ -56,11 +56,23 @@ void add64(uint k, int v)
     if (hi != 0u) atomicAdd(sums[k + 1u], hi);
 }
 
+// add64 on the counts buffer (the energy account)
+void add64c(uint k, int v)
+{
+    if (v == 0) return;
+    uint u = uint(v);
+    uint old = atomicAdd(counts[k], u);
+    uint hi = (v < 0 ? 0xffffffffu : 0u) + (old + u < old ? 1u : 0u);
+    if (hi != 0u) atomicAdd(counts[k + 1u], hi);
+}
+
 // The photon's visit to one cell so far: its pieces' w len (rgb) and
 // lum(w) len d, added to the cell's sums once, when it leaves the cell
 // (or ends): a photon that collides many times in a cell pays one set of
 // atomics for the visit, not one a piece.
 vec3 visit_phi, visit_flux;
+// The photon's energy account (core/shared.glsl.h): its sums so far, in W (the track length in W m).
+vec3 acc_in, acc_out, acc_absorbed, acc_coll, acc_track;
 float visit_len;
 bool visit_any;
 
@@ -93,9 +105,26 @@ void visit(ivec3 c, vec3 w, vec3 d, float len, bool odd)
 {
     if (visit_len + len > float(VEIL_CACHE_VISIT_DIAGONALS) * 1.7320508 * cb.origin.w) flush(c, odd);
     visit_phi += w * len;
+    acc_track += w * len;
     visit_flux += dot(w, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B)) * len * d;
     visit_len += len;
     visit_any = true;
+}
+
+// The photon's energy account, added when it ends (the groups: photon n mod VEIL_CACHE_ENERGY_GROUPS).
+void account(uint n)
+{
+    if (!(max(acc_in.r, max(acc_in.g, acc_in.b)) > 0.0)) return;
+    uint k = 4u + (n % uint(VEIL_CACHE_ENERGY_GROUPS)) * uint(6 * VEIL_CACHE_ENERGY_KINDS);
+    float u = cb.power.w, xi = rnd();
+    for (int c = 0; c < 3; ++c) {
+        add64c(k + uint(6 * VEIL_CACHE_ENERGY_IN + 2 * c), veil_cache_fixed(acc_in[c] * u, xi));
+        add64c(k + uint(6 * VEIL_CACHE_ENERGY_OUT + 2 * c), veil_cache_fixed(acc_out[c] * u, xi));
+        add64c(k + uint(6 * VEIL_CACHE_ENERGY_ABSORBED + 2 * c), veil_cache_fixed(acc_absorbed[c] * u, xi));
+        add64c(k + uint(6 * VEIL_CACHE_ENERGY_COLLISIONS + 2 * c), veil_cache_fixed(acc_coll[c] * u * (1.0 / 65536.0), xi));
+        add64c(k + uint(6 * VEIL_CACHE_ENERGY_TRACK + 2 * c),
+               veil_cache_fixed(acc_track[c] * u / (65536.0 * 1.7320508 * cb.origin.w), xi));
+    }
 }
 
 // A unit vector at cos_t from axis a, azimuth phi.
@@ -119,11 +148,9 @@ vec3 scatter_hg(vec3 d, float g)
     return around(d, cos_t, 2.0 * VEIL_PI * rnd());
 }
 
-void main()
+// Photon n, from its start to its end; a photon cut at the step cap is counted, its account left out.
+void trace(uint n)
 {
-    uint n = cb.source.z + gl_GlobalInvocationID.x;
-    if (n >= cb.source.w) return;
-    state = mix32(cb.seed.x ^ mix32(cb.seed.y * 0x9e3779b9u ^ mix32(n)));
     float h = cb.origin.w;
     vec3 grid_hi = cb.origin.xyz + vec3(cb.dims.xyz) * h;
     vec3 pos, dir, w = cb.power.rgb;
@@ -156,6 +183,7 @@ void main()
     if (!(max(w.r, max(w.g, w.b)) > 0.0)) return;
     vec2 span = box_hit(pos, dir, cb.origin.xyz, grid_hi, 0.0, INF);
     if (span.x >= span.y) return;
+    if (scored) acc_in = w; // the emission's light enters the account at its start
     pos += dir * span.x;
     ivec3 c = clamp(ivec3(floor((pos - cb.origin.xyz) / h)), ivec3(0), cb.dims.xyz - 1);
     ivec3 step_dir = ivec3(sign(dir));
@@ -183,7 +211,10 @@ void main()
             tau -= maj * t_exit;
             pos += dir * t_exit;
             c[axis] += step_dir[axis];
-            if (c[axis] < 0 || c[axis] >= cb.dims[axis]) break;
+            if (c[axis] < 0 || c[axis] >= cb.dims[axis]) {
+                if (scored) acc_out = w;
+                break;
+            }
             continue;
         }
         float t = tau / maj;
@@ -196,12 +227,17 @@ void main()
         vec3 s_n = max(vec3(maj) - s_s - s_a, vec3(0.0));
         float sw = maj * (w.r + w.g + w.b);
         float p_s = dot(w, s_s) / sw, p_a = dot(w, s_a) / sw, p_n = dot(w, s_n) / sw;
+        if (scored) acc_coll += w * (s_s + s_a) / maj;
         float xi = rnd() * (p_s + p_a + p_n); // their sum is 1 but for rounding
-        if (xi < p_a) break; // absorbed (the visit so far is flushed below)
+        if (xi < p_a) { // absorbed (the visit so far is flushed below)
+            if (scored) acc_absorbed = w * s_a / (maj * p_a);
+            break;
+        }
         if (xi < p_a + p_s) {
             w *= s_s / (maj * p_s);
             dir = scatter_hg(dir, g);
             step_dir = ivec3(sign(dir));
+            if (!scored) acc_in = w;
             scored = true;
         } else {
             w *= s_n / (maj * p_n);
@@ -209,5 +245,18 @@ void main()
         tau = -log(1.0 - rnd());
     }
     flush(c, odd); // the last visit: absorbed, or cut (a path that left the grid has flushed already)
-    if (steps == cap) atomicAdd(counts[0], 1u);
+    if (steps == cap) {
+        atomicAdd(counts[0], 1u);
+        acc_in = vec3(0.0), acc_out = vec3(0.0), acc_absorbed = vec3(0.0), acc_coll = vec3(0.0), acc_track = vec3(0.0);
+    }
+}
+
+void main()
+{
+    uint n = cb.source.z + gl_GlobalInvocationID.x;
+    state = mix32(cb.seed.x ^ mix32(cb.seed.y * 0x9e3779b9u ^ mix32(n)));
+    acc_in = vec3(0.0), acc_out = vec3(0.0), acc_absorbed = vec3(0.0), acc_coll = vec3(0.0), acc_track = vec3(0.0);
+    if (n >= cb.source.w) return;
+    trace(n);
+    account(n);
 }
