@@ -382,7 +382,8 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     b.scale[0] = (float)units;
     b.scale[1] = (float)(1.0 / units);
     /* the energy account: a photon's channel weight is at most 3 phi_max, 2^VEIL_CACHE_FIXED_BITS units */
-    const double units_e = phi_max > 0.0 ? ldexp(1.0, VEIL_CACHE_FIXED_BITS) / (3.0 * phi_max) : 1.0;
+    /* (as the shader holds it: a float) */
+    const double units_e = (float)(phi_max > 0.0 ? ldexp(1.0, VEIL_CACHE_FIXED_BITS) / (3.0 * phi_max) : 1.0);
     glUseProgram(p->trace[sparse]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_CACHE_EMIT, buf[2]);
     for (int j = 0; j < n_src; ++j) {
@@ -418,16 +419,18 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     glGetNamedBufferSubData(buf[3], 0, sizeof counts, counts);
     rep->cut = counts[0], rep->clamped = counts[1], rep->misses = counts[2];
     for (int g = 0; g < VEIL_CACHE_ENERGY_GROUPS; ++g)
-        for (int q = 0; q < VEIL_CACHE_ENERGY_KINDS; ++q)
+        for (int q = 0; q < VEIL_CACHE_ENERGY_KINDS; ++q) {
+            /* the units of each kind (core/shared.glsl.h) */
+            double per_unit = 1.0 / units_e;
+            if (q == VEIL_CACHE_ENERGY_COLLISIONS) per_unit *= 65536.0;
+            if (q == VEIL_CACHE_ENERGY_TRACK) per_unit *= 65536.0 * sqrt(3.0) * h;
             for (int c = 0; c < 3; ++c) {
                 const uint32_t* w = &counts[4 + 2 * (3 * (VEIL_CACHE_ENERGY_KINDS * g + q) + c)];
-                int64_t v = (int64_t)(((uint64_t)w[1] << 32) | w[0]);
-                double watts = (double)v / units_e *
-                               (q == VEIL_CACHE_ENERGY_COLLISIONS ? 65536.0
-                                                                  : (q == VEIL_CACHE_ENERGY_TRACK ? 65536.0 * sqrt(3.0) * h : 1.0));
+                double watts = (double)(int64_t)(((uint64_t)w[1] << 32) | w[0]) * per_unit;
                 rep->energy_groups[g][q][c] = watts;
                 rep->energy[q][c] += watts;
             }
+        }
 
     /* 5. the noise: odd photons against even ones, E (o - e)^2 = Var(o + e) per cell */
     free(cellv);
