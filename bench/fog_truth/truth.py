@@ -25,19 +25,15 @@ Calibration to veil (each checked by calibrate.py against a closed form):
 - world black, no clamping, no light threshold, no adaptive sampling, no
   denoising; 256 bounces of every kind (volume included), so nothing is cut.
 """
-import math
 import os
 import sys
 
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import blender_setup  # noqa: E402
 import scenes  # noqa: E402
-
-
-def bl(v):
-    """veil (x, y, z) -> blender (x, -z, y)"""
-    return (v[0], -v[2], v[1])
+from blender_setup import bl  # noqa: E402
 
 
 def diffuse_material(name, albedo):
@@ -117,13 +113,6 @@ def fog_material(c):
     return m
 
 
-def look_rotation(ob, eye, target, up):
-    from mathutils import Vector
-    d = Vector(target) - Vector(eye)
-    ob.rotation_euler = d.to_track_quat("-Z", "Y").to_euler()
-    # the camera's up: to_track_quat with 'Y' keeps blender's +Z (veil's +y) up
-
-
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:]
     if len(argv) != 5:
@@ -144,82 +133,20 @@ def main():
         f.data.materials.clear()
         f.data.materials.append(bpy.data.materials["fog"])
 
-    for i, l in enumerate(c["lights"]):
-        if l["type"] == "point":
-            I = l["intensity"]
-            peak = max(I)
-            ld = bpy.data.lights.new("lamp%d" % i, "POINT")
-            ld.energy = 4.0 * math.pi * peak  # W; Cycles: I = P / (4 pi) W/sr
-            ld.color = tuple(v / peak for v in I)
-            ld.shadow_soft_size = 0.0
-            ob = bpy.data.objects.new("lamp%d" % i, ld)
-            ob.location = bl(l["position"])
-        else:
-            E = l["irradiance"]
-            peak = max(E)
-            ld = bpy.data.lights.new("sun%d" % i, "SUN")
-            ld.energy = peak  # W/m^2
-            ld.color = tuple(v / peak for v in E)
-            ld.angle = 0.0
-            ob = bpy.data.objects.new("sun%d" % i, ld)
-            from mathutils import Vector
-            ob.rotation_euler = Vector(bl(l["direction"])).to_track_quat("-Z", "Y").to_euler()
-        ld.cycles.max_bounces = 1024
-        sc.collection.objects.link(ob)
+    blender_setup.add_lights(sc, c["lights"])
 
     cam = scenes.CAMERA
-    cd = bpy.data.cameras.new("cam")
-    cd.sensor_fit = "VERTICAL"
-    cd.angle_y = math.radians(cam["fov_y_deg"])
-    cd.clip_start = 0.01
-    cd.clip_end = 1e4
-    co = bpy.data.objects.new("cam", cd)
-    co.location = bl(cam["position"])
-    look_rotation(co, bl(cam["position"]), bl(cam["look_at"]), bl(cam["up"]))
-    sc.collection.objects.link(co)
-    sc.camera = co
-
-    world = bpy.data.worlds.new("black")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    sc.world = world
-
-    r = sc.render
-    r.engine = "CYCLES"
-    r.resolution_x, r.resolution_y, r.resolution_percentage = cam["width"], cam["height"], 100
-    r.pixel_aspect_x = r.pixel_aspect_y = 1.0
-    r.film_transparent = False
-    r.use_persistent_data = False
-    r.threads_mode = "FIXED"
-    r.threads = 2
+    blender_setup.add_camera(sc, cam)
+    blender_setup.black_world(sc)
+    blender_setup.unbiased(sc, cam["width"], cam["height"], samples, seed, 256, out)
     cy = sc.cycles
-    cy.device = "CPU"
-    cy.samples = samples
-    cy.seed = seed
-    cy.use_adaptive_sampling = False
-    cy.use_denoising = False
-    cy.max_bounces = cy.diffuse_bounces = cy.volume_bounces = 256
-    cy.glossy_bounces = cy.transmission_bounces = cy.transparent_max_bounces = 256
-    cy.sample_clamp_direct = 0.0
-    cy.sample_clamp_indirect = 0.0
-    cy.light_sampling_threshold = 0.0
-    cy.filter_width = 0.01
     cy.volume_step_rate = 1.0
     cy.volume_max_steps = 4096
     cy.caustics_reflective = cy.caustics_refractive = True
     cy.blur_glossy = 0.0
-    sc.view_settings.view_transform = "Standard"
-
     vl = sc.view_layers[0]
-    vl.use_pass_combined = True
     vl.use_pass_z = True
     vl.use_pass_diffuse_direct = vl.use_pass_diffuse_indirect = vl.use_pass_diffuse_color = True
-    vl.cycles.use_pass_volume_direct = vl.cycles.use_pass_volume_indirect = True
-    im = r.image_settings
-    im.file_format = "OPEN_EXR_MULTILAYER"
-    im.color_depth = "32"
-    im.exr_codec = "ZIP"
-    r.filepath = out
     bpy.ops.render.render(write_still=True)
 
 
