@@ -47,24 +47,19 @@ float rnd()
 // A signed 64-bit add of v to the word pair at k (low word first): the low
 // word's atomic returns what it held, so its carry is known; the high word
 // gets the carry and v's sign extension. Any order of adds gives the same sum.
-void add64(uint k, int v)
-{
-    if (v == 0) return;
-    uint u = uint(v);
-    uint old = atomicAdd(sums[k], u);
-    uint hi = (v < 0 ? 0xffffffffu : 0u) + (old + u < old ? 1u : 0u);
-    if (hi != 0u) atomicAdd(sums[k + 1u], hi);
-}
-
-// add64 on the counts buffer (the energy account)
-void add64c(uint k, int v)
-{
-    if (v == 0) return;
-    uint u = uint(v);
-    uint old = atomicAdd(counts[k], u);
-    uint hi = (v < 0 ? 0xffffffffu : 0u) + (old + u < old ? 1u : 0u);
-    if (hi != 0u) atomicAdd(counts[k + 1u], hi);
-}
+// One for each buffer (GLSL passes no buffer to a function): add64 on the
+// cells' sums, add64c on the counts (the energy account).
+#define VEIL_ADD64(NAME, WORDS)                                              \
+    void NAME(uint k, int v)                                                 \
+    {                                                                        \
+        if (v == 0) return;                                                  \
+        uint u = uint(v);                                                    \
+        uint old = atomicAdd(WORDS[k], u);                                   \
+        uint hi = (v < 0 ? 0xffffffffu : 0u) + (old + u < old ? 1u : 0u);    \
+        if (hi != 0u) atomicAdd(WORDS[k + 1u], hi);                          \
+    }
+VEIL_ADD64(add64, sums)
+VEIL_ADD64(add64c, counts)
 
 // The photon's visit to one cell so far: its pieces' w len (rgb) and
 // lum(w) len d, added to the cell's sums once, when it leaves the cell
