@@ -39,11 +39,11 @@
  *    from the spread of the 8 groups of photons (photon n in group n mod 8),
  *    a sum's standard error sqrt(8 s^2) with s^2 the groups' sample
  *    variance (7 degrees of freedom: |t| > 5.41 has probability 1e-3), so
- *    5.5 standard errors; a photon's channel weights sum to a constant
+ *    5.5 standard errors, of paired differences where two sums are
+ *    compared; a photon's channel weights sum to a constant
  *    (cache_trace.comp), so albedo 1 conserves each photon's sum exactly
- *    but for the fixed point's rounding, |e| < 1 unit per add, unbiased and
- *    independent: by Hoeffding, over 2 N adds of range 2 units the sum's
- *    error exceeds 2 sqrt(2 N ln(2 / 1e-9)) units with probability 1e-9. */
+ *    but for the fixed point's and the floats' rounding (Hoeffding over the
+ *    photons, derived where it is checked). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -149,14 +149,15 @@ static void determinism(veil_volumetric* d)
     for (int i = 0; i < 3; ++i) free(out[i]);
 }
 
-/* The sum over groups of one kind and channel, and its standard error from the groups' spread; with
- * `minus` (a kind, or -1) and factor k, of the paired difference kind - k minus. */
-static double group_sum(const veil_cache_report* c, int kind, int minus, double k, int ch, double* se)
+/* The sum over the groups of sum_i k[i] x kind[i] (n terms) in channel ch, and its standard error from
+ * the groups' spread: paired, so what the terms share cancels group by group. */
+static double group_sum(const veil_cache_report* c, int n, const int* kind, const double* k, int ch, double* se)
 {
     const int G = VEIL_CACHE_ENERGY_GROUPS;
     double v[VEIL_CACHE_ENERGY_GROUPS], mean = 0.0, ss = 0.0;
     for (int g = 0; g < G; ++g) {
-        v[g] = c->energy_groups[g][kind][ch] - (minus >= 0 ? k * c->energy_groups[g][minus][ch] : 0.0);
+        v[g] = 0.0;
+        for (int i = 0; i < n; ++i) v[g] += k[i] * c->energy_groups[g][kind[i]][ch];
         mean += v[g] / G;
     }
     for (int g = 0; g < G; ++g) ss += (v[g] - mean) * (v[g] - mean);
@@ -201,15 +202,16 @@ static void energy(veil_volumetric* d)
         for (int ch = 0; ch < 3; ++ch) {
             double st = (double)s.medium.sigma_s[ch] + s.medium.sigma_a[ch], se;
             double want = sun.color[ch] * A * (s.medium.sigma_s[ch] / st) * (1.0 - exp(-st * L));
-            double in = group_sum(c, VEIL_CACHE_ENERGY_IN, -1, 0.0, ch, &se);
+            const int k_in[1] = {VEIL_CACHE_ENERGY_IN};
+            const int k_bal[3] = {VEIL_CACHE_ENERGY_IN, VEIL_CACHE_ENERGY_OUT, VEIL_CACHE_ENERGY_ABSORBED};
+            const int k_coll[2] = {VEIL_CACHE_ENERGY_COLLISIONS, VEIL_CACHE_ENERGY_TRACK};
+            const double one[1] = {1.0}, bal_k[3] = {1.0, -1.0, -1.0}, coll_k[2] = {1.0, -st};
+            double in = group_sum(c, 1, k_in, one, ch, &se);
             CHECK(fabs(in - want) <= 5.5 * se, "%s, channel %d: scattered %.6g W, closed form %.6g (5.5 se %.3g)",
                   names[kase], ch, in, want, 5.5 * se);
-            /* what scattered = what left + what was absorbed: the paired difference */
+            /* what scattered = what left + what was absorbed: in - out - absorbed, paired by group */
             double out = c->energy[VEIL_CACHE_ENERGY_OUT][ch], ab = c->energy[VEIL_CACHE_ENERGY_ABSORBED][ch];
-            double bal = group_sum(c, VEIL_CACHE_ENERGY_IN, VEIL_CACHE_ENERGY_OUT, 1.0, ch, &se) - ab;
-            double se_ab;
-            group_sum(c, VEIL_CACHE_ENERGY_ABSORBED, -1, 0.0, ch, &se_ab);
-            double tol = 5.5 * sqrt(se * se + se_ab * se_ab); /* the two sums' errors: at most the root of the sum */
+            double bal = group_sum(c, 3, k_bal, bal_k, ch, &se), tol = 5.5 * se;
             CHECK(fabs(bal) <= tol, "%s, channel %d: scattered %.6g W, left %.6g + absorbed %.6g: off by %.3g > %.3g",
                   names[kase], ch, in, out, ab, bal, tol);
             if (absorbing)
@@ -221,18 +223,22 @@ static void energy(veil_volumetric* d)
             double cells = 0.0;
             for (size_t k = 0; phi && k < 12 * 12 * 12; ++k) cells += phi[4 * k + ch] * V;
             double track = c->energy[VEIL_CACHE_ENERGY_TRACK][ch];
-            /* the same pieces of path, rounded apart: Hoeffding over the adds (the cells': at most a visit a
-             * step, cap + 1 a photon; the account's: one a photon), each within one unit, unbiased; the
-             * texture's float (2^-24 relative a cell) on top */
+            /* the same pieces of path, rounded apart. The fixed point: each add within one unit, unbiased,
+             * independent of the others of this channel (its own random number); Hoeffding over the adds
+             * (the cells': at most a visit a step, cap + 1 a photon; the account's: one a photon) gives
+             * sqrt(2 ln(2/1e-9)) sqrt(n_c u_c^2 + n_a u_a^2), at most half of what is taken here. The
+             * floats: a photon's track length is a float sum of at most cap pieces (recursive summation of
+             * positive terms: within cap 2^-24 of it), and each cell a float in the texture (2^-24 of it;
+             * 1728 cells taken at 6e-8 of the whole, a bound as loose) */
             double phi_max = 3.0 * A / (double)c->photons, h = 2.0 / 12.0;
             double unit_cells = 3.0 * phi_max * sqrt(3.0) * h / 1048576.0, unit_acc = 65536.0 * unit_cells;
             double n_cells = (double)c->photons * (c->cap + 1.0), n_acc = (double)c->photons;
             double tol_t = 2.0 * sqrt(2.0 * log(2.0 / 1e-9)) * (sqrt(n_cells) * unit_cells + sqrt(n_acc) * unit_acc) +
-                           1728.0 * 6e-8 * track;
+                           (c->cap * ldexp(1.0, -24) + 1728.0 * 6e-8) * track;
             CHECK(fabs(cells - track) <= tol_t, "channel %d: the cells' fluence times volume %.9g W m, the photons' "
                   "track length %.9g: off by %.3g > %.3g", ch, cells, track, cells - track, tol_t);
             if (!height) { /* sigma_t the same everywhere: the two estimate one integral */
-                double coll = group_sum(c, VEIL_CACHE_ENERGY_COLLISIONS, VEIL_CACHE_ENERGY_TRACK, st, ch, &se);
+                double coll = group_sum(c, 2, k_coll, coll_k, ch, &se);
                 CHECK(fabs(coll) <= 5.5 * se, "channel %d: collision estimator - sigma_t x track length = %.4g "
                       "(5.5 se %.3g; track %.6g W m)", ch, coll, 5.5 * se, track);
             }
@@ -244,10 +250,15 @@ static void energy(veil_volumetric* d)
         if (!absorbing) {
             /* each photon's channel sum is kept exactly: only the rounding separates in from out. Units of the
              * account: a photon's channel weight <= 3 phi_max = 2^20 units, phi_max the largest channel of
-             * a photon's power, here E_max A / N */
+             * a photon's power, here E_max A / N. A photon's six adds (in, out; three channels) share one
+             * random number, so its rounding error, within (-6, 6) units, is what is independent: Hoeffding
+             * over N photons, P(|sum| >= t) <= 2 exp(-2 t^2 / (N 12^2)), t = 6 sqrt(2 N ln(2/1e-9)) units.
+             * The floats: each step's update w_c *= s_c / (sigma_bar P) rounds each of the three channels
+             * within 2^-24 of itself, so the weights' sum moves by at most 3 2^-24 of it a step, at most
+             * cap steps: 3 cap 2^-24 of what scattered. */
             double unit = 3.0 * 3.0 * A / (double)c->photons / 1048576.0;
-            double adds = 2.0 * 3.0 * (double)c->photons;
-            double bound = 2.0 * sqrt(2.0 * adds * log(2.0 / 1e-9)) * unit;
+            double bound = 6.0 * sqrt(2.0 * (double)c->photons * log(2.0 / 1e-9)) * unit +
+                           3.0 * c->cap * ldexp(1.0, -24) * sum_in;
             CHECK(fabs(sum_out - sum_in) <= bound, "albedo 1: the channels' sum %.9g W in, %.9g out: off by %.3g > "
                   "%.3g (the fixed point's rounding)", sum_in, sum_out, sum_out - sum_in, bound);
             printf("energy: albedo 1, %.9g W scattered, %.9g W left (rounding bound %.2g)\n", sum_in, sum_out, bound);
