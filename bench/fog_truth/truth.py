@@ -33,7 +33,6 @@ import bpy
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import blender_setup  # noqa: E402
 import scenes  # noqa: E402
-from blender_setup import bl  # noqa: E402
 
 
 def diffuse_material(name, albedo):
@@ -49,70 +48,6 @@ def diffuse_material(name, albedo):
     return m
 
 
-def box(name, lo, hi, material):
-    a, b = bl(lo), bl(hi)
-    mn = [min(a[i], b[i]) for i in range(3)]
-    mx = [max(a[i], b[i]) for i in range(3)]
-    centre = [(mn[i] + mx[i]) / 2 for i in range(3)]
-    size = [(mx[i] - mn[i]) for i in range(3)]
-    bpy.ops.mesh.primitive_cube_add(size=1.0, location=centre)
-    ob = bpy.context.active_object
-    ob.name = name
-    ob.scale = size
-    bpy.ops.object.transform_apply(location=False, rotation=False, scale=True)  # object scale 1: densities in m^-1
-    ob.data.materials.append(material)
-    return ob
-
-
-def fog_material(c):
-    m = bpy.data.materials.new("fog")
-    m.use_nodes = True
-    nt = m.node_tree
-    nt.nodes.clear()
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
-    scat = nt.nodes.new("ShaderNodeVolumeScatter")
-    absb = nt.nodes.new("ShaderNodeVolumeAbsorption")
-    add = nt.nodes.new("ShaderNodeAddShader")
-    scat.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-    scat.inputs["Anisotropy"].default_value = c["g"]
-    absb.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-    ss, sa = c["sigma_s"][0], c["sigma_a"][0]
-    assert c["sigma_s"] == [ss] * 3 and c["sigma_a"] == [sa] * 3, "grey media only"
-    rho0, b = c["fog"]["density"], c["fog"]["falloff"]
-    if b == 0.0:  # constant density: Cycles' homogeneous path (exact distance sampling)
-        scat.inputs["Density"].default_value = ss * rho0
-        absb.inputs["Density"].default_value = sa * rho0
-    else:  # rho = rho0 exp(-b y), y = blender Z of the world position
-        geo = nt.nodes.new("ShaderNodeNewGeometry")
-        sep = nt.nodes.new("ShaderNodeSeparateXYZ")
-        mul = nt.nodes.new("ShaderNodeMath")
-        mul.operation = "MULTIPLY"
-        mul.inputs[1].default_value = -b
-        ex = nt.nodes.new("ShaderNodeMath")
-        ex.operation = "EXPONENT"
-        ks = nt.nodes.new("ShaderNodeMath")
-        ks.operation = "MULTIPLY"
-        ks.inputs[1].default_value = ss * rho0
-        ka = nt.nodes.new("ShaderNodeMath")
-        ka.operation = "MULTIPLY"
-        ka.inputs[1].default_value = sa * rho0
-        nt.links.new(geo.outputs["Position"], sep.inputs[0])
-        nt.links.new(sep.outputs["Z"], mul.inputs[0])
-        nt.links.new(mul.outputs[0], ex.inputs[0])
-        nt.links.new(ex.outputs[0], ks.inputs[0])
-        nt.links.new(ex.outputs[0], ka.inputs[0])
-        nt.links.new(ks.outputs[0], scat.inputs["Density"])
-        nt.links.new(ka.outputs[0], absb.inputs["Density"])
-        # procedural density: Cycles marches with 1/10 of the box's mean size
-        # times this rate (and the scene's rate): 0.1 * 87 m * 0.06 = 0.52 m (b dt = 0.1: the jittered
-        # march's optical depth has a variance far below the noise)
-        m.cycles.volume_step_rate = 0.06
-    nt.links.new(scat.outputs[0], add.inputs[0])
-    nt.links.new(absb.outputs[0], add.inputs[1])
-    nt.links.new(add.outputs[0], out.inputs["Volume"])
-    return m
-
-
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:]
     if len(argv) != 5:
@@ -125,11 +60,11 @@ def main():
     sc = bpy.context.scene
 
     for i, (lo, hi, albedo) in enumerate(scenes.BOXES):
-        box("box%d" % i, lo, hi, diffuse_material("mat%d" % i, (0.0, 0.0, 0.0) if fog == 2 else albedo))
+        blender_setup.box("box%d" % i, lo, hi, diffuse_material("mat%d" % i, (0.0, 0.0, 0.0) if fog == 2 else albedo))
 
     if fog:
         lo, hi = scenes.FOG_BOX
-        f = box("fog", lo, hi, fog_material(c))
+        f = blender_setup.box("fog", lo, hi, blender_setup.fog_material(c))
         f.data.materials.clear()
         f.data.materials.append(bpy.data.materials["fog"])
 
