@@ -338,7 +338,10 @@ VEIL_STRUCT_END(veil_diffusion_block)
  * gives the same cache bit for bit. */
 #define VEIL_CACHE_GROUP 64        /* photons per work group */
 #define VEIL_CACHE_CELL_GROUP 4    /* 4^3 cells per work group (bounds, resolve) */
-#define VEIL_CACHE_SUMS 7          /* per cell: fluence r, g, b; flux x, y, z; the odd photons' luminance fluence */
+#define VEIL_CACHE_SUMS 13         /* per cell: fluence r, g, b and flux x, y, z of the light scattered once
+                                      (emission: not yet scattered); the odd photons' luminance fluence (all);
+                                      fluence rgb and flux xyz of the light scattered more often */
+#define VEIL_CACHE_LATER 14        /* the word where the second set of sums begins */
 #define VEIL_CACHE_WORDS (2 * VEIL_CACHE_SUMS)
 /* A piece of path (at most a cell's diagonal) scores at most
  * 2^VEIL_CACHE_FIXED_BITS units (volumetric/cache.c derives the unit from
@@ -369,12 +372,15 @@ VEIL_STRUCT_END(veil_diffusion_block)
 #define VEIL_CACHE_ENERGY_ABSORBED 2
 #define VEIL_CACHE_ENERGY_COLLISIONS 3
 #define VEIL_CACHE_ENERGY_TRACK 4
-#define VEIL_CACHE_ENERGY_KINDS 5
+#define VEIL_CACHE_ENERGY_LATER_IN 5    /* the weight that scattered again (emission: at all): the later light */
+#define VEIL_CACHE_ENERGY_LATER_TRACK 6 /* the later light's track length (units as _TRACK) */
+#define VEIL_CACHE_ENERGY_KINDS 7
 #define VEIL_CACHE_ENERGY_WORDS (2 * 3 * VEIL_CACHE_ENERGY_KINDS * VEIL_CACHE_ENERGY_GROUPS)
 #define VEIL_UBO_CACHE 7
-/* The cache is one rgba32f texture of two stacked grids (cells nx, ny, 2 nz): z in [0, nz) the fluence rgb
- * with the odd photons' luminance fluence in a, z in [nz, 2 nz) the luminance-weighted flux xyz. One
- * sampler reads both (the march clamps z within a half, so filtering never crosses): on Mesa 22's
+/* The cache is one rgba32f texture of four stacked grids (cells nx, ny, 4 nz): z in [0, nz) the fluence rgb
+ * with the odd photons' luminance fluence in a, z in [nz, 2 nz) the luminance-weighted flux xyz, then the
+ * same two of the later light alone (scattered more than once; emission: scattered), in [2 nz, 3 nz) and
+ * [3 nz, 4 nz). One sampler reads them all (the march clamps z within a half, so filtering never crosses): on Mesa 22's
  * llvmpipe a second 3D sampler read with texture() in the march returned 0 on all but the first
  * invocation of each row of a work group (texelFetch did not). */
 #define VEIL_IMAGE_CACHE 0         /* image unit: the cache, written by the resolve pass */

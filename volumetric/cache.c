@@ -244,13 +244,13 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     if (r == VEIL_OK)
         r = veil_gl_buffer(NULL, (4 + VEIL_CACHE_ENERGY_WORDS) * sizeof(uint32_t), GL_DYNAMIC_STORAGE_BIT,
                            "veil cache counts", &buf[3], err);
-    const int stacked[3] = {dims[0], dims[1], 2 * dims[2]};
+    const int stacked[3] = {dims[0], dims[1], 4 * dims[2]};
     if (r == VEIL_OK) r = field_texture(stacked, "veil light cache (fluence, flux)", tex, err);
     if (r != VEIL_OK) goto done;
     static const uint32_t zero = 0;
     glClearNamedBufferData(buf[0], GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glClearNamedBufferData(buf[3], GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-    rep->bytes = (double)cells * (VEIL_CACHE_WORDS * 4.0 + 8.0 + 32.0); /* sums, cells, the texture */
+    rep->bytes = (double)cells * (VEIL_CACHE_WORDS * 4.0 + 8.0 + 64.0); /* sums, cells, the texture */
 
     /* 1. the cells' majorants (and emission weights) */
     r = veil_gl_buffer(mu, sizeof *mu, 0, "veil cache medium block", &medium_ubo, err);
@@ -423,7 +423,7 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
             /* the units of each kind (core/shared.glsl.h) */
             double per_unit = 1.0 / units_e;
             if (q == VEIL_CACHE_ENERGY_COLLISIONS) per_unit *= 65536.0;
-            if (q == VEIL_CACHE_ENERGY_TRACK) per_unit *= 65536.0 * sqrt(3.0) * h;
+            if (q == VEIL_CACHE_ENERGY_TRACK || q == VEIL_CACHE_ENERGY_LATER_TRACK) per_unit *= 65536.0 * sqrt(3.0) * h;
             for (int c = 0; c < 3; ++c) {
                 const uint32_t* w = &counts[4 + 2 * (3 * (VEIL_CACHE_ENERGY_KINDS * g + q) + c)];
                 double watts = (double)(int64_t)(((uint64_t)w[1] << 32) | w[0]) * per_unit;
@@ -434,12 +434,12 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
 
     /* 5. the noise: odd photons against even ones, E (o - e)^2 = Var(o + e) per cell */
     free(cellv);
-    cellv = malloc(cells * 8 * sizeof *cellv);
+    cellv = malloc(cells * 16 * sizeof *cellv);
     if (!cellv) {
         r = veil_fail(err, VEIL_ERR_OOM, "out of memory reading the light cache back");
         goto done;
     }
-    r = veil_gl_read_texture(*tex, GL_RGBA, cells * 8, cellv, "the light cache", err);
+    r = veil_gl_read_texture(*tex, GL_RGBA, cells * 16, cellv, "the light cache", err);
     if (r != VEIL_OK) goto done;
     double dd = 0.0, tt = 0.0;
     for (size_t k = 0; k < cells; ++k) {

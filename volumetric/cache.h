@@ -6,14 +6,19 @@
  * What it holds, per cell of a grid over the medium (the EV's box and the
  * fogs' boxes): the fluence phi (W/m^2, rgb) of light that has scattered at
  * least once — for the medium's emission, of all its light, scattered or
- * not — and the luminance-weighted flux F (W/m^2, a vector). The march adds
- *   sigma_s rho phi p_HG(F^ . w_o; g |F| / phi_lum)
- * per unit length: the radiance field taken as one Henyey-Greenstein lobe
- * about F with mean cosine |F| / phi (an HG lobe's first moment is g times
- * its axis), scattered by the medium's HG(g); HG convolved with HG is HG
- * with the product of the g's (their Legendre coefficients g^l multiply).
- * So the march's own single scattering (exact, with the optical depths) plus
- * the cache's orders >= 2 count every order once.
+ * not — and the luminance-weighted flux F (W/m^2, a vector); and the same
+ * two of the later light alone, scattered more than once (emission: at
+ * least once). The march (render/shaders/march.comp, cache_in) adds per
+ * unit length, for the light scattered once,
+ *   sigma_s rho phi p_HG(F^ . w_o; g |F| / phi_lum):
+ * its radiance taken as one Henyey-Greenstein lobe about F with mean
+ * cosine |F| / phi (an HG lobe's first moment is g times its axis),
+ * scattered by the medium's HG(g); HG convolved with HG is HG with the
+ * product of the g's (their Legendre coefficients g^l multiply). The later
+ * light the same, but with the phase function's forward peak (f = g^2, as
+ * delta-Eddington) carried along the camera's ray by a reduced extinction
+ * instead of by the lobe. So the march's own single scattering (exact, with
+ * the optical depths) plus the cache's orders >= 2 count every order once.
  *
  * The estimator (volumetric/shaders/cache_trace.comp): photons start at a
  * source with power Phi (a sun: on a rectangle across its light covering
@@ -71,7 +76,8 @@ typedef struct veil_cache_report {
     /* The energy account (core/shared.glsl.h), W per channel: [VEIL_CACHE_ENERGY_IN] the light that
      * scattered (or was emitted), [_OUT] what of it left the grid, [_ABSORBED] what was absorbed,
      * [_COLLISIONS] the collision estimator of the integral of sigma_t phi (W), [_TRACK] the track length
-     * sum, the integral of phi (W m: the cells' fluence times their volume, summed); in all and per group
+     * sum, the integral of phi (W m: the cells' fluence times their volume, summed); [_LATER_IN] and
+     * [_LATER_TRACK] the same two of the later light (scattered again; emission: scattered); in all and per group
      * of photons (photon n in group n mod VEIL_CACHE_ENERGY_GROUPS). Photons cut at `cap` are left out. */
     double energy[VEIL_CACHE_ENERGY_KINDS][3];
     double energy_groups[VEIL_CACHE_ENERGY_GROUPS][VEIL_CACHE_ENERGY_KINDS][3];

@@ -341,20 +341,20 @@ veil_result veil_volumetric_update(veil_volumetric* d, const veil_volumetric_des
     return VEIL_OK;
 }
 
-/* The kept field's texture read back: its first (half = 0) or, for the light cache's stacked
- * texture, its second grid (half = 1). */
-static float* readback(const veil_volumetric* d, int half, int dims[3])
+/* The kept field's texture read back: its first grid (layer 0) or, for the light cache's stacked
+ * texture, another of its four (core/shared.glsl.h). */
+static float* readback(const veil_volumetric* d, int layer, int dims[3])
 {
     if (!d->phi) return NULL;
     const int stacked = d->field.kind == VEIL_FIELD_CACHE;
-    if (half && !stacked) return NULL;
+    if (layer && !stacked) return NULL;
     size_t n = (size_t)d->dims[0] * (size_t)d->dims[1] * (size_t)d->dims[2] * 4;
-    float* out = malloc((stacked ? 2 : 1) * n * sizeof *out);
+    float* out = malloc((stacked ? 4 : 1) * n * sizeof *out);
     if (!out) return NULL;
-    glGetTextureImage(d->phi, 0, GL_RGBA, GL_FLOAT, (GLsizei)((stacked ? 2 : 1) * n * sizeof *out), out);
-    if (half) memmove(out, out + n, n * sizeof *out);
+    glGetTextureImage(d->phi, 0, GL_RGBA, GL_FLOAT, (GLsizei)((stacked ? 4 : 1) * n * sizeof *out), out);
+    if (layer) memmove(out, out + (size_t)layer * n, n * sizeof *out);
     memcpy(dims, d->dims, 3 * sizeof *dims);
-    return out; /* (a stacked texture's second half stays allocated until it is freed) */
+    return out; /* (a stacked texture's other layers stay allocated until it is freed) */
 }
 
 float* veil_volumetric_readback(const veil_volumetric* d, int dims[3])
@@ -365,6 +365,11 @@ float* veil_volumetric_readback(const veil_volumetric* d, int dims[3])
 float* veil_volumetric_readback_flux(const veil_volumetric* d, int dims[3])
 {
     return readback(d, 1, dims);
+}
+
+float* veil_volumetric_readback_later(const veil_volumetric* d, int dims[3])
+{
+    return readback(d, 2, dims);
 }
 
 uint64_t veil_volumetric_key(uint64_t ev_key, const veil_volumetric_desc* d)

@@ -121,5 +121,8 @@ uint64_t veil_volumetric_key(uint64_t ev_key, const veil_volumetric_desc* d);
 float* veil_volumetric_readback(const veil_volumetric* v, int dims[3]);
 /* The light cache's flux read back the same way (xyz, w 0); NULL for other fields. */
 float* veil_volumetric_readback_flux(const veil_volumetric* v, int dims[3]);
+/* The light cache's later light (scattered more than once; emission: scattered) read back the same
+ * way (rgb phi, w 0); NULL for other fields. */
+float* veil_volumetric_readback_later(const veil_volumetric* v, int dims[3]);
 
 #endif

@@ -31,6 +31,11 @@
 // J (exp(-sigma_a P) - exp(-sigma_t P)) with J the step's light before
 // attenuation and P the density integral from the camera to the step; its
 // alpha is the luminance-weighted mean of that P.
+// The light cache (u.diffusion.w = VEIL_FIELD_CACHE; cache_in): its lobes
+// per step, weighted by the transmittance of a reduced extinction that
+// carries the forward peak of the phase function along the ray; the march
+// then ends where that transmittance, not T, is negligible (single
+// scattering stops where T is).
 // Emission (med.shape.w, in the variant compiled with VEIL_MARCH_EMISSION):
 // the EV's emission texture eps per step, integrated in closed form like
 // in-scattering, added to L (the medium's own light).
@@ -121,24 +126,48 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
     // scattered again, isotropically, towards the camera
     if (u.diffusion.w == float(VEIL_FIELD_FLUENCE))
         multi += texture(u_phi, (x - u.diffusion.xyz) * u.diffusion_inv.xyz).rgb * (1.0 / (4.0 * VEIL_PI));
-    // the light cache (volumetric/cache.h): the fluence phi of light scattered
-    // at least once (of the emission, all its light) as one HG lobe about its
-    // flux F with mean cosine |F| / phi, scattered by the medium's HG(g):
-    // HG(g |F| / phi) about F, towards the camera. The grid covers the medium;
-    // the texture stacks the fluence (z in [0, nz)) on the flux ([nz, 2 nz)).
-    if (u.diffusion.w == float(VEIL_FIELD_CACHE)) {
-        vec3 c = (x - u.diffusion.xyz) * u.diffusion_inv.xyz;
-        if (all(greaterThanEqual(c, vec3(0.0))) && all(lessThanEqual(c, vec3(1.0)))) {
-            float nz = u.diffusion_inv.w, z = clamp(c.z * nz, 0.5, nz - 0.5);
-            vec3 phi = texture(u_phi, vec3(c.xy, z / (2.0 * nz))).rgb;
-            vec3 F = texture(u_phi, vec3(c.xy, (z + nz) / (2.0 * nz))).xyz;
-            float pl = dot(phi, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B)), fl = length(F);
-            float gc = pl > 0.0 && fl > 0.0 ? min(fl / pl, 1.0) : 0.0;
-            vec3 axis = fl > 0.0 ? F / fl : vec3(0.0, 0.0, 1.0);
-            multi += max(phi, vec3(0.0)) * veil_phase_hg(dot(axis, -dir), med.shape.z * gc);
-        }
-    }
     return sum;
+}
+
+// The light cache (volumetric/cache.h) towards -dir at x, per unit sigma_s
+// rho. It holds two lights, each a fluence phi and a flux F: the light
+// scattered once (of the emission: not yet scattered) and the later light
+// (scattered more often). Each is taken as one HG lobe about F with mean
+// cosine mu = |F| / phi, which the medium's HG(g) scatters into HG(g mu)
+// about F (HG convolved with HG is HG with the product of the g's). That is
+// how the once-scattered light is used. For the later light it is right
+// inside the medium and wrong at its skin, where the light going towards the
+// camera is what built up along the ray behind x (docs/multiple-scattering.md,
+// "What the error is"). So the phase function is split as delta-Eddington
+// splits it (Joseph et al. 1976): p = f delta + (1 - f) p' with f = g^2
+// (returned in f_peak by main). The delta's share, f L(x, -dir), is the later light arriving along
+// the ray itself: main carries it by integrating with the reduced extinction
+// sigma_t - f sigma_s (light scattered into the delta keeps its direction).
+// Here is the rest: the lobe's scattering less the lobe's own delta share,
+// phi (HG(g mu) - f HG(mu)) — exact where the lobe is the radiance, since
+// then the two delta terms cancel (a control variate), and negative where the
+// lobe is peaked towards the camera (the ray's share makes up for it).
+float cache_lobe(vec3 phi, vec3 F, vec3 dir, float g)
+{
+    float pl = dot(phi, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B)), fl = length(F);
+    float gc = pl > 0.0 && fl > 0.0 ? min(fl / pl, 1.0) : 0.0;
+    vec3 axis = fl > 0.0 ? F / fl : vec3(0.0, 0.0, 1.0);
+    return veil_phase_hg(dot(axis, -dir), g * gc);
+}
+
+vec3 cache_in(vec3 x, vec3 dir, float f)
+{
+    vec3 c = (x - u.diffusion.xyz) * u.diffusion_inv.xyz;
+    if (!(all(greaterThanEqual(c, vec3(0.0))) && all(lessThanEqual(c, vec3(1.0))))) return vec3(0.0);
+    float nz = u.diffusion_inv.w, z = clamp(c.z * nz, 0.5, nz - 0.5);
+    vec3 phi = texture(u_phi, vec3(c.xy, z / (4.0 * nz))).rgb;
+    vec3 F = texture(u_phi, vec3(c.xy, (z + nz) / (4.0 * nz))).xyz;
+    vec3 phi2 = texture(u_phi, vec3(c.xy, (z + 2.0 * nz) / (4.0 * nz))).rgb;
+    vec3 F2 = texture(u_phi, vec3(c.xy, (z + 3.0 * nz) / (4.0 * nz))).xyz;
+    float g = med.shape.z;
+    vec3 phi1 = max(phi - phi2, vec3(0.0)); // the texture holds all the light and the later light
+    phi2 = max(phi2, vec3(0.0));
+    return phi1 * cache_lobe(phi1, F - F2, dir, g) + phi2 * (cache_lobe(phi2, F2, dir, g) - f * cache_lobe(phi2, F2, dir, 1.0));
 }
 
 // Distance to the nearest point or spot light (INF without one).
@@ -158,6 +187,12 @@ void main()
                   1.0 - 2.0 * (float(p.y) + 0.5) / float(u.size.xy.y));
     vec3 dir = normalize(u.cam_fwd.xyz + s.x * u.cam_right.xyz + s.y * u.cam_up.xyz);
     vec3 T = vec3(1.0), L = vec3(0.0), Lv = vec3(0.0), Q = vec3(0.0);
+    // the light cache's forward peak f (cache_in: g^2 of the phase function; 0 for g <= 0, and without a
+    // cache, where T_red is T) and the transmittance of the reduced extinction sigma_t - f sigma_s that
+    // carries the later light along the ray: the march goes on until it, not T, is negligible
+    bool cache = u.diffusion.w == float(VEIL_FIELD_CACHE);
+    float f_peak = cache ? max(med.shape.z, 0.0) * max(med.shape.z, 0.0) : 0.0;
+    vec3 T_red = vec3(1.0);
     float q_p = 0.0, q_w = 0.0;        // luminance-weighted P of Q
     float P = 0.0;                     // density integral along the ray (density m)
     float depth_sum = 0.0, depth_w = 0.0; // extinction-weighted distance
@@ -241,9 +276,19 @@ void main()
             precise vec3 w = T * j;
             vec3 multi;
             float p_mid = min(P + 0.5 * rho_dt, INF); // finite, as D: a channel with sigma = 0 gets exp(0)
-            vec3 single = in_scattered(x, dir, p_mid, multi);
+            // past where the light's own transmittance ends the march, only the cache's later light goes on
+            multi = vec3(0.0);
+            vec3 single = max(T.r, max(T.g, T.b)) >= VEIL_MIN_TRANSMITTANCE ? in_scattered(x, dir, p_mid, multi) : vec3(0.0);
             L += w * single;
             Lv += w * multi;
+            vec3 opt_red = (med.sigma_t.rgb - f_peak * med.sigma_s.rgb) * rho_dt;
+            if (cache) {
+                vec3 frac_red = vec3(veil_step_integral(opt_red.r), veil_step_integral(opt_red.g), veil_step_integral(opt_red.b));
+                precise vec3 j_red = med.sigma_s.rgb * (rho_dt * frac_red);
+                precise vec3 w_red = T_red * j_red;
+                Lv += w_red * cache_in(x, dir, f_peak);
+            }
+            T_red *= exp(-opt_red);
             vec3 q = j * single * max(exp(-(med.sigma_t.rgb - med.sigma_s.rgb) * p_mid) - exp(-med.sigma_t.rgb * p_mid), 0.0);
             float yq = dot(q, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B));
             Q += q;
@@ -255,10 +300,13 @@ void main()
             depth_w += absorbed;
             P += rho_dt;
             T = T_next;
-            if (max(T.r, max(T.g, T.b)) < VEIL_MIN_TRANSMITTANCE) break;
+            if (max(T_red.r, max(T_red.g, T_red.b)) < VEIL_MIN_TRANSMITTANCE) break;
         }
         t = te;
     }
+    // the cache's part may dip below 0 where its lobe's correction outweighs what came along the ray
+    // (a noisy or coarse lobe); radiance is not negative
+    Lv = max(Lv, vec3(0.0));
     imageStore(u_out, p, vec4(L + Lv + T * u.background.rgb, 1.0 - (T.r + T.g + T.b) / 3.0));
     imageStore(u_aov_v, p, vec4(Lv, 0.0));
     imageStore(u_aov_q, p, vec4(Q, q_w > 0.0 ? min(q_p / q_w, INF) : 0.0));

@@ -196,6 +196,8 @@ static void energy(veil_volumetric* d)
         float* phi = veil_volumetric_readback(d, dims);
         CHECK(phi != NULL && dims[0] == 12 && dims[1] == 12 && dims[2] == 12, "the cache read back (%dx%dx%d)",
               dims[0], dims[1], dims[2]);
+        float* later = veil_volumetric_readback_later(d, dims);
+        CHECK(later != NULL, "the cache's later light read back");
         /* the column's density integral from y = 1 down to -1: L = 2, or (e^0.8 - e^-0.8) / 0.8 */
         const double A = 4.0, L = height ? (exp(falloff) - exp(-falloff)) / falloff : 2.0, V = pow(2.0 / 12.0, 3.0);
         double sum_in = 0.0, sum_out = 0.0;
@@ -220,9 +222,11 @@ static void energy(veil_volumetric* d)
             else
                 CHECK(ab == 0.0, "channel %d: %.4g W absorbed at albedo 1", ch, ab);
             /* the fluence's cells hold the track length; sigma_t times it is what the collisions measure */
-            double cells = 0.0;
+            double cells = 0.0, cells_later = 0.0;
             for (size_t k = 0; phi && k < 12 * 12 * 12; ++k) cells += phi[4 * k + ch] * V;
+            for (size_t k = 0; later && k < 12 * 12 * 12; ++k) cells_later += later[4 * k + ch] * V;
             double track = c->energy[VEIL_CACHE_ENERGY_TRACK][ch];
+            double track_later = c->energy[VEIL_CACHE_ENERGY_LATER_TRACK][ch];
             /* the same pieces of path, rounded apart. The fixed point: each add within one unit, unbiased,
              * independent of the others of this channel (its own random number); Hoeffding over the adds
              * (the cells': at most a visit a step, cap + 1 a photon; the account's: one a photon) gives
@@ -237,6 +241,24 @@ static void energy(veil_volumetric* d)
                            (c->cap * ldexp(1.0, -24) + 1728.0 * 6e-8) * track;
             CHECK(fabs(cells - track) <= tol_t, "channel %d: the cells' fluence times volume %.9g W m, the photons' "
                   "track length %.9g: off by %.3g > %.3g", ch, cells, track, cells - track, tol_t);
+            /* the later light alone (its pieces are a subset of the same adds: the same bound holds) */
+            CHECK(track_later > 0.05 * track && track_later < track, "channel %d: the later light's track %.4g of %.4g",
+                  ch, track_later, track);
+            CHECK(fabs(cells_later - track_later) <= tol_t, "channel %d: the later light's cells %.9g W m, its "
+                  "track length %.9g: off by %.3g > %.3g", ch, cells_later, track_later, cells_later - track_later,
+                  tol_t);
+            if (!height) {
+                /* Where the once-scattered light ends: what scatters a second time has the mean
+                 * sigma_s x its track length (each tentative collision scatters w sigma_s / sigma_bar in the
+                 * mean, and tentative collisions come at rate sigma_bar along the track), paired by group.
+                 * Split at the wrong scattering, or a visit scored to the wrong lobe, it is not. */
+                const int k_split[3] = {VEIL_CACHE_ENERGY_LATER_IN, VEIL_CACHE_ENERGY_TRACK, VEIL_CACHE_ENERGY_LATER_TRACK};
+                const double split_k[3] = {1.0, -s.medium.sigma_s[ch], s.medium.sigma_s[ch]};
+                double split = group_sum(c, 3, k_split, split_k, ch, &se);
+                CHECK(fabs(split) <= 5.5 * se, "%s, channel %d: scattered again %.6g W, sigma_s x the once-scattered "
+                      "track %.6g: off by %.3g > %.3g", names[kase], ch, c->energy[VEIL_CACHE_ENERGY_LATER_IN][ch],
+                      s.medium.sigma_s[ch] * (track - track_later), split, 5.5 * se);
+            }
             if (!height) { /* sigma_t the same everywhere: the two estimate one integral */
                 double coll = group_sum(c, 2, k_coll, coll_k, ch, &se);
                 CHECK(fabs(coll) <= 5.5 * se, "channel %d: collision estimator - sigma_t x track length = %.4g "
@@ -244,8 +266,8 @@ static void energy(veil_volumetric* d)
             }
             sum_in += in, sum_out += out;
             printf("energy (%s) channel %d: scattered %.5g W (closed form %.5g), left %.5g, absorbed %.4g; track "
-                   "%.8g W m, cells %.8g (bound %.2g)\n", names[kase], ch, in, want, out,
-                   ab, track, cells, tol_t);
+                   "%.8g W m, cells %.8g (bound %.2g); scattered again %.5g W, later track %.6g W m\n", names[kase],
+                   ch, in, want, out, ab, track, cells, tol_t, c->energy[VEIL_CACHE_ENERGY_LATER_IN][ch], track_later);
         }
         if (!absorbing) {
             /* each photon's channel sum is kept exactly: only the rounding separates in from out. Units of the
@@ -264,6 +286,7 @@ static void energy(veil_volumetric* d)
             printf("energy: albedo 1, %.9g W scattered, %.9g W left (rounding bound %.2g)\n", sum_in, sum_out, bound);
         }
         free(phi);
+        free(later);
     }
 }
 

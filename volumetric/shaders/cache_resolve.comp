@@ -2,7 +2,9 @@
 // 64-bit fixed-point sums turned into the fields the march samples, stacked
 // in one texture (core/shared.glsl.h says why): the fluence rgb (W/m^2) with
 // the odd photons' luminance fluence beside it (for the noise estimate), and
-// nz cells above it the luminance-weighted flux (W/m^2).
+// nz cells above it the luminance-weighted flux (W/m^2), of all the light;
+// above those the same two of the light scattered more than once (for the
+// emission: scattered at all).
 layout(local_size_x = VEIL_CACHE_CELL_GROUP, local_size_y = VEIL_CACHE_CELL_GROUP, local_size_z = VEIL_CACHE_CELL_GROUP) in;
 layout(std140, binding = VEIL_UBO_CACHE) uniform veil_cache_ubo { veil_cache_block cb; };
 layout(std430, binding = VEIL_BIND_CACHE_SUM) readonly buffer veil_cache_sums { uint sums[]; };
@@ -23,6 +25,11 @@ void main()
     ivec3 c = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(c, cb.dims.xyz))) return;
     uint k = (uint(c.x) + uint(cb.dims.x) * (uint(c.y) + uint(cb.dims.y) * uint(c.z))) * uint(VEIL_CACHE_WORDS);
-    imageStore(u_cache, c, vec4(sum_at(k), sum_at(k + 2u), sum_at(k + 4u), sum_at(k + 12u)));
-    imageStore(u_cache, c + ivec3(0, 0, cb.dims.z), vec4(sum_at(k + 6u), sum_at(k + 8u), sum_at(k + 10u), 0.0));
+    uint l = k + uint(VEIL_CACHE_LATER);
+    vec3 phi1 = vec3(sum_at(k), sum_at(k + 2u), sum_at(k + 4u)), flux1 = vec3(sum_at(k + 6u), sum_at(k + 8u), sum_at(k + 10u));
+    vec3 phi2 = vec3(sum_at(l), sum_at(l + 2u), sum_at(l + 4u)), flux2 = vec3(sum_at(l + 6u), sum_at(l + 8u), sum_at(l + 10u));
+    imageStore(u_cache, c, vec4(phi1 + phi2, sum_at(k + 12u)));
+    imageStore(u_cache, c + ivec3(0, 0, cb.dims.z), vec4(flux1 + flux2, 0.0));
+    imageStore(u_cache, c + ivec3(0, 0, 2 * cb.dims.z), vec4(phi2, 0.0));
+    imageStore(u_cache, c + ivec3(0, 0, 3 * cb.dims.z), vec4(flux2, 0.0));
 }

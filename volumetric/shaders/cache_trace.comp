@@ -66,8 +66,12 @@ VEIL_ADD64(add64c, counts)
 // (or ends): a photon that collides many times in a cell pays one set of
 // atomics for the visit, not one a piece.
 vec3 visit_phi, visit_flux;
+// Which sums the photon's pieces go to: those of the light scattered once
+// (emission: not yet scattered), or, from its next scattering on, the
+// later ones (the march gives the two lobes different phase functions).
+bool later;
 // The photon's energy account (core/shared.glsl.h): its sums so far, in W (the track length in W m).
-vec3 acc_in, acc_out, acc_absorbed, acc_coll, acc_track;
+vec3 acc_in, acc_out, acc_absorbed, acc_coll, acc_track, acc_later_in, acc_later_track;
 float visit_len;
 bool visit_any;
 
@@ -75,7 +79,8 @@ bool visit_any;
 void flush(ivec3 c, bool odd)
 {
     if (!visit_any) return;
-    uint k = (uint(c.x) + uint(cb.dims.x) * (uint(c.y) + uint(cb.dims.y) * uint(c.z))) * uint(VEIL_CACHE_WORDS);
+    uint k0 = (uint(c.x) + uint(cb.dims.x) * (uint(c.y) + uint(cb.dims.y) * uint(c.z))) * uint(VEIL_CACHE_WORDS);
+    uint k = k0 + (later ? uint(VEIL_CACHE_LATER) : 0u);
     float u = cb.scale.z * cb.scale.x; // units per W m of weight times length
     float xi = rnd();
     vec3 p = visit_phi * u, f = visit_flux * u;
@@ -85,7 +90,7 @@ void flush(ivec3 c, bool odd)
     add64(k + 6u, veil_cache_fixed(f.x, xi));
     add64(k + 8u, veil_cache_fixed(f.y, xi));
     add64(k + 10u, veil_cache_fixed(f.z, xi));
-    if (odd) add64(k + 12u, veil_cache_fixed(dot(p, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B)), xi));
+    if (odd) add64(k0 + 12u, veil_cache_fixed(dot(p, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B)), xi));
     if (max(p.r, max(p.g, p.b)) > float(VEIL_CACHE_VISIT_DIAGONALS << VEIL_CACHE_FIXED_BITS))
         atomicAdd(counts[1], 1u);
     visit_phi = vec3(0.0), visit_flux = vec3(0.0);
@@ -101,6 +106,7 @@ void visit(ivec3 c, vec3 w, vec3 d, float len, bool odd)
     if (visit_len + len > float(VEIL_CACHE_VISIT_DIAGONALS) * 1.7320508 * cb.origin.w) flush(c, odd);
     visit_phi += w * len;
     acc_track += w * len;
+    if (later) acc_later_track += w * len;
     visit_flux += dot(w, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B)) * len * d;
     visit_len += len;
     visit_any = true;
@@ -119,6 +125,9 @@ void account(uint n)
         add64c(k + uint(6 * VEIL_CACHE_ENERGY_COLLISIONS + 2 * c), veil_cache_fixed(acc_coll[c] * u * (1.0 / 65536.0), xi));
         add64c(k + uint(6 * VEIL_CACHE_ENERGY_TRACK + 2 * c),
                veil_cache_fixed(acc_track[c] * u / (65536.0 * 1.7320508 * cb.origin.w), xi));
+        add64c(k + uint(6 * VEIL_CACHE_ENERGY_LATER_IN + 2 * c), veil_cache_fixed(acc_later_in[c] * u, xi));
+        add64c(k + uint(6 * VEIL_CACHE_ENERGY_LATER_TRACK + 2 * c),
+               veil_cache_fixed(acc_later_track[c] * u / (65536.0 * 1.7320508 * cb.origin.w), xi));
     }
 }
 
@@ -175,6 +184,7 @@ void trace(uint n)
         dir = around(vec3(0.0, 0.0, 1.0), 1.0 - 2.0 * rnd(), 2.0 * VEIL_PI * rnd());
         scored = true;
     }
+    later = false;
     if (!(max(w.r, max(w.g, w.b)) > 0.0)) return;
     vec2 span = box_hit(pos, dir, cb.origin.xyz, grid_hi, 0.0, INF);
     if (span.x >= span.y) return;
@@ -233,6 +243,11 @@ void trace(uint n)
             dir = scatter_hg(dir, g);
             step_dir = ivec3(sign(dir));
             if (!scored) acc_in = w;
+            else if (!later) {
+                flush(c, odd); // what was scattered once ends here
+                later = true;
+                acc_later_in = w;
+            }
             scored = true;
         } else {
             w *= s_n / (maj * p_n);
@@ -243,6 +258,7 @@ void trace(uint n)
     if (steps == cap) {
         atomicAdd(counts[0], 1u);
         acc_in = vec3(0.0), acc_out = vec3(0.0), acc_absorbed = vec3(0.0), acc_coll = vec3(0.0), acc_track = vec3(0.0);
+        acc_later_in = vec3(0.0), acc_later_track = vec3(0.0);
     }
 }
 
@@ -251,6 +267,7 @@ void main()
     uint n = cb.source.z + gl_GlobalInvocationID.x;
     state = mix32(cb.seed.x ^ mix32(cb.seed.y * 0x9e3779b9u ^ mix32(n)));
     acc_in = vec3(0.0), acc_out = vec3(0.0), acc_absorbed = vec3(0.0), acc_coll = vec3(0.0), acc_track = vec3(0.0);
+    acc_later_in = vec3(0.0), acc_later_track = vec3(0.0);
     if (n >= cb.source.w) return;
     trace(n);
     account(n);
