@@ -24,6 +24,12 @@ mean_bias (mean RGB / reference's - 1). --study adds the screen-space
 pass's filter sizes and interpolations, and its MIP chains against the
 gathering filter (bench/spread_gather).
 
+The references' noise is heavy-tailed on the bright clouds: against 8192-spp
+references, the 512-spp one of the side-lit cumulus was 28 % off per 4x4 block
+while its own standard errors said 16 %, and the cloud's (a lamp inside a dense
+puff) 98 % off against 9.7 %. So the cumulus scenes render their references
+at REF_SPP_SCALE times --spp; the results in docs/ are at --spp 4096.
+
 References are cached in build/bench-cache/ms/, keyed by the scene text, the
 image size, spp and the bytes of the veil binary that renders them
 (--ref-veil, default --veil). Scenes in
@@ -61,6 +67,10 @@ CANDIDATES = [
 ]
 STUDY = [("screen %s %s" % (f, i), {"screen_space": True, "volumetric": False, "filter": f, "interpolation": i},
           "default") for f in ("2x2", "4x4", "6x6") for i in ("linear-bilinear", "linear-bicubic", "cubic-bicubic")]
+
+
+# scenes whose reference takes more samples than --spp (see the docstring)
+REF_SPP_SCALE = {"cumulus, sun behind": 2, "cumulus, sun at the side": 2}
 
 
 def shared_scene(vdb, camera, sigma_a, sigma_s, g, lights, scale=1.0):
@@ -205,7 +215,7 @@ def converge(a, names, w, h, spp, ref_veil, cache, tmp):
         if name not in names:
             continue
         scene = absolutise(base, folder)
-        ref = reference(scene, name, w, h, spp, ref_veil, cache, tmp)
+        ref = reference(scene, name, w, h, spp * REF_SPP_SCALE.get(name, 1), ref_veil, cache, tmp)
         budgets = [(1 << p, 96) for p in range(12, 23)] + [(1 << 22, c) for c in (16, 24, 40, 64)]
         for photons, cells in budgets:
             ms = dict(CACHE, cache_photons=photons, cache_cells=cells)
@@ -284,7 +294,7 @@ def main():
         for k in ((1.0, a.thick) if thick and not a.quick else (1.0,)):
             scene = absolutise(thicken(base, k), folder)
             label = name if k == 1.0 else "%s x%g" % (name, k)
-            ref = reference(scene, label, w, h, spp, ref_veil, cache, tmp)
+            ref = reference(scene, label, w, h, spp * REF_SPP_SCALE.get(name, 1), ref_veil, cache, tmp)
             for vname, ms, quality in variants:
                 if a.quick and vname.startswith("screen "):
                     continue
