@@ -241,6 +241,9 @@ void main()
         }
         float step = in_ev ? u.march.x
                            : max(u.march.x, min(VEIL_FOG_STEP_FRACTION * max(t, u.march.x), 0.25 * nearest_light(x0)));
+        // past where T ends single scattering only the cache's later light goes on: steps of half its cell
+        if (cache && max(T.r, max(T.g, T.b)) < VEIL_MIN_TRANSMITTANCE)
+            step = max(step, 0.5 / (u.diffusion_inv.z * u.diffusion_inv.w));
         if (first) step *= jitter;
         first = false;
         float te = min(t + step, t_end);
