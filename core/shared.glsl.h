@@ -380,7 +380,7 @@ VEIL_STRUCT_END(veil_diffusion_block)
 /* The cache is one rgba32f texture of four stacked grids (cells nx, ny, 4 nz): z in [0, nz) the fluence rgb
  * with the odd photons' luminance fluence in a, z in [nz, 2 nz) the luminance-weighted flux xyz, then the
  * same two of the later light alone (scattered more than once; emission: scattered), in [2 nz, 3 nz) and
- * [3 nz, 4 nz). One sampler reads them all (the march clamps z within a half, so filtering never crosses): on Mesa 22's
+ * [3 nz, 4 nz). One sampler reads them all (the march clamps z within a quarter, so filtering never crosses): on Mesa 22's
  * llvmpipe a second 3D sampler read with texture() in the march returned 0 on all but the first
  * invocation of each row of a work group (texelFetch did not). */
 #define VEIL_IMAGE_CACHE 0         /* image unit: the cache, written by the resolve pass */

@@ -390,7 +390,7 @@ static veil_result volumetric_build(veil_frame* f, veil_stage_report* rep, veil_
             "noise %.2g %% a cell (fluence-weighted RMS), %.1f MiB while built, %.1f MiB kept%s",
             c->photons, c->sources, c->sources == 1 ? "" : "s", c->dims[0], c->dims[1], c->dims[2], (double)c->cell,
             100.0 * c->noise, c->bytes / 1048576.0,
-            (double)c->dims[0] * c->dims[1] * c->dims[2] * 32.0 / 1048576.0,
+            (double)c->dims[0] * c->dims[1] * c->dims[2] * 64.0 / 1048576.0, /* the texture: four rgba32f grids */
             c->cut || c->clamped ? "" : "");
         double e_in = VEIL_LUM_R * c->energy[VEIL_CACHE_ENERGY_IN][0] + VEIL_LUM_G * c->energy[VEIL_CACHE_ENERGY_IN][1] +
                       VEIL_LUM_B * c->energy[VEIL_CACHE_ENERGY_IN][2];

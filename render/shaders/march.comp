@@ -140,9 +140,10 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
 // camera is what built up along the ray behind x (docs/multiple-scattering.md,
 // "What the error is"). So the phase function is split as delta-Eddington
 // splits it (Joseph et al. 1976): p = f delta + (1 - f) p' with f = g^2
-// (returned in f_peak by main). The delta's share, f L(x, -dir), is the later light arriving along
-// the ray itself: main carries it by integrating with the reduced extinction
-// sigma_t - f sigma_s (light scattered into the delta keeps its direction).
+// (f_peak in main). The delta's share, f L(x, -dir), is the later light
+// arriving along the ray itself: main carries it by integrating with the
+// reduced extinction sigma_t - f sigma_s (light scattered into the delta
+// keeps its direction).
 // Here is the rest: the lobe's scattering less the lobe's own delta share,
 // phi (HG(g mu) - f HG(mu)) — exact where the lobe is the radiance, since
 // then the two delta terms cancel (a control variate), and negative where the
