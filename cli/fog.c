@@ -1,5 +1,5 @@
 /* veil fog FRAME.exr --scene fog.json -o OUT.exr [--png OUT.png]
- *                  [--depth-channel NAME] [--depth-is z|distance] [--aovs] [--stats]
+ *                  [--depth-channel NAME] [--depth-is z|distance] [--no-occluders] [--aovs] [--stats]
  *
  * Adds the scene's medium to a frame rendered elsewhere with the scene's
  * camera (the paper's own use case: Iser & Elek 2018): the surfaces in
@@ -7,7 +7,9 @@
  * scattering (and the volumetric estimate) is added in front of them, and
  * the light they send through the medium is spread (screen-space multiple
  * scattering: glow and blur). The medium, lights and settings come from the
- * scene; its background is replaced by the frame.
+ * scene; its background is replaced by the frame. The frame's surfaces are
+ * also solid for the medium's light (scene/solid.h): they shadow it from the
+ * lights and absorb the light cache's photons; --no-occluders turns that off.
  *
  * FRAME: R, G, B (linear radiance; A is ignored) and a depth channel, the
  * first of Z, depth.Z, depth, distance that it holds (or --depth-channel).
@@ -39,7 +41,7 @@
 
 typedef struct fog_args {
     const char *frame, *scene, *exr, *png, *depth_channel;
-    int depth_is_distance, aovs, stats;
+    int depth_is_distance, aovs, stats, no_occluders;
 } fog_args;
 
 static int parse_fog_args(int argc, char** argv, fog_args* a)
@@ -50,6 +52,7 @@ static int parse_fog_args(int argc, char** argv, fog_args* a)
         const char* v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(s, "--aovs")) { a->aovs = 1; continue; }
         if (!strcmp(s, "--stats")) { a->stats = 1; continue; }
+        if (!strcmp(s, "--no-occluders")) { a->no_occluders = 1; continue; }
         int takes = !strcmp(s, "-o") || !strcmp(s, "--png") || !strcmp(s, "--scene") ||
                     !strcmp(s, "--depth-channel") || !strcmp(s, "--depth-is");
         if (takes && !v) return veil_cli_usage_error("%s needs a value", s);
@@ -198,7 +201,7 @@ int veil_cmd_fog(int argc, char** argv)
     veil_render_stats st = {0};
     if (r == VEIL_OK) r = veil_renderer_create_deferred(NULL, &ren, &err);
     if (r == VEIL_OK) {
-        veil_render_opts opts = {.behind = frame, .behind_distance = depth};
+        veil_render_opts opts = {.behind = frame, .behind_distance = depth, .behind_not_solid = a.no_occluders};
         veil_cli_progress_begin(NULL);
         r = veil_render_scene_images(ren, &scene, &opts, &im, &st, &err);
         veil_cli_progress_end();

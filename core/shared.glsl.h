@@ -120,6 +120,11 @@
  * so they share units with the sparse tables (9..13), never bound then. */
 #define VEIL_MAX_SUNS 4
 #define VEIL_TEX_SUN0 9
+/* The surfaces of a frame under `veil fog` as a solid (scene/solid.h): the
+ * r8 voxels (1: solid) and an r32f array of shadow maps, one layer a light. */
+#define VEIL_TEX_SOLID 14
+#define VEIL_TEX_SHADOW 15
+#define VEIL_SOLID_MAP 256
 
 /* A light as the GPU sees it: one shape for every shader (std140, 48 bytes).
  * Filled from scene/light.h's veil_light by veil_light_to_gpu(). */
@@ -159,6 +164,10 @@ VEIL_STRUCT_BEGIN(veil_medium_block)
     VEIL_V4(sun_map[3 * VEIL_MAX_SUNS]);   /* 3k .. 3k+2: grid k's world -> texture rows (xyz . x + w) */
     VEIL_V4(sun_step[VEIL_MAX_SUNS]);      /* grid k: x: node spacing along the light (m), y: nodes along it,
                                               z: density samples of the last stretch (propagate/shaders/lit_medium.glsl) */
+    VEIL_V4(solid_origin); /* xyz: the frame's solid's min corner (m); w: its voxel (m), 0: no solid (scene/solid.h) */
+    VEIL_IV4(solid_dims);  /* xyz: its voxels an axis; w: shadow maps (light l < w has layer l) */
+    VEIL_V4(shadow[3 * VEIL_MAX_LIGHTS]);  /* light l: 3l, 3l+1: a sun's map coordinates dot(x, xyz) + w;
+                                              3l+2: x: bias (m), y: bias per m along the light's path */
 VEIL_STRUCT_END(veil_medium_block)
 
 /* What the ray marcher (render/shaders/march.comp) reads besides the
@@ -356,6 +365,9 @@ VEIL_STRUCT_END(veil_diffusion_block)
 #define VEIL_BIND_CACHE_EMIT 2     /* the emitting cells: uvec2 (cell, the CDF up to it as float bits) */
 #define VEIL_BIND_CACHE_COUNT 3    /* uint[4]: photons cut at the step cap, scores clamped, majorant misses, -;
                                       then the energy account's int64 sums (below) */
+#define VEIL_BIND_CACHE_FREE 4     /* float[cells]: the part of each cell not inside a frame's solid (scene/solid.h);
+                                      the resolve divides by it, at least VEIL_CACHE_MIN_FREE */
+#define VEIL_CACHE_MIN_FREE 0.125
 /* The energy account of the light that scattered (or was emitted): per
  * group of photons (photon n in group n mod VEIL_CACHE_ENERGY_GROUPS, for a
  * standard error), per channel, the weight that entered (at its first

@@ -115,6 +115,7 @@ static veil_result run_frame(veil_renderer* r, veil_frame* f, veil_render_stats*
         if (r->ready) glFinish();
         rep->ms = veil_now_ms() - t0 - (f->gpu_ms - gpu0);
     }
+    veil_frame_end(f);
     st->inject_ms = st->stage[VEIL_STAGE_INJECT].ms;
     st->propagate_ms = st->stage[VEIL_STAGE_PROPAGATE].ms;
     st->render_ms = st->stage[VEIL_STAGE_RENDER].ms;

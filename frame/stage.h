@@ -26,7 +26,7 @@ typedef enum veil_stage_status {
     VEIL_STAGE_SKIPPED
 } veil_stage_status;
 
-#define VEIL_STAGE_WHY_MAX 256
+#define VEIL_STAGE_WHY_MAX 512
 
 typedef struct veil_stage_report {
     veil_stage_status status;

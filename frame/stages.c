@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/clock.h"
 #include "../core/hash.h"
 #include "../gpu/gl_context.h"
 #include "../propagate/lit_medium.h"
@@ -39,7 +40,42 @@ static veil_lit_medium lit_medium(const veil_frame* f)
     m.sparse = veil_ev_sparse_of(f->parts->ev);
     m.emission = veil_ev_emission(f->parts->ev);
     m.suns = veil_opv_set_suns(f->parts->opv, &m.sun_count);
+    if (f->solid.voxels) m.solid = &f->solid, m.solid_voxels = f->solid_tex[0], m.solid_maps = f->solid_tex[1];
     return m;
+}
+
+/* veil fog's surfaces as a solid, once a frame, over the medium's boxes (the EV's and the fogs'): the
+ * rows that light the medium (volumetric, render) call it before they read lit_medium(). */
+static veil_result frame_solid(veil_frame* f, veil_error* err)
+{
+    const veil_frame_plan* p = &f->plan;
+    if (f->solid_made || !p->o.behind_distance || p->o.behind_not_solid) return VEIL_OK;
+    f->solid_made = 1;
+    const double t0 = veil_now_ms();
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    if (p->grid) veil_grid_medium_box(p->grid, lo, hi);
+    const veil_medium* m = &p->scene->medium;
+    for (size_t i = 0; i < m->source_count; ++i)
+        if (m->sources[i].type == VEIL_SOURCE_EXPONENTIAL)
+            for (int a = 0; a < 3; ++a) {
+                lo[a] = fminf(lo[a], m->sources[i].fog.bounds[0][a]);
+                hi[a] = fmaxf(hi[a], m->sources[i].fog.bounds[1][a]);
+            }
+    if (!(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2])) return VEIL_OK;
+    veil_result r = veil_solid_build(p->o.camera, p->o.width, p->o.height, p->o.behind_distance, lo, hi, p->lights,
+                                     p->light_count, &f->solid, err);
+    if (r != VEIL_OK || !f->solid.voxels) return r;
+    r = veil_lit_medium_solid_textures(&f->solid, f->solid_tex, err);
+    f->solid_ms = veil_now_ms() - t0;
+    return r;
+}
+
+void veil_frame_end(veil_frame* f)
+{
+    if (f->solid_tex[0] || f->solid_tex[1]) glDeleteTextures(2, f->solid_tex);
+    f->solid_tex[0] = f->solid_tex[1] = 0;
+    veil_solid_free(&f->solid);
+    f->solid_made = 0;
 }
 
 /* The EV changed (or is gone): nothing made from it is valid any more. */
@@ -307,7 +343,9 @@ static int volumetric_sources(const veil_frame_plan* p)
 static uint64_t volumetric_key(const veil_frame_plan* p)
 {
     if (p->volumetric.kind == VEIL_FIELD_NONE || volumetric_sources(p) == 0) return 0;
-    return veil_volumetric_key(p->ev_key, &p->volumetric);
+    /* under veil fog the frame's surfaces absorb the cache's photons: its depth is part of the key */
+    uint64_t key = veil_volumetric_key(p->ev_key, &p->volumetric);
+    return p->o.behind_not_solid ? key : veil_solid_key(key, p->o.width, p->o.height, p->o.behind_distance);
 }
 
 static veil_stage_status volumetric_decide(const veil_frame_plan* p, int kept, char* w, size_t n)
@@ -366,6 +404,8 @@ static veil_stage_status volumetric_decide(const veil_frame_plan* p, int kept, c
 
 static veil_result volumetric_build(veil_frame* f, veil_stage_report* rep, veil_error* err)
 {
+    veil_result sr = frame_solid(f, err);
+    if (sr != VEIL_OK) return sr;
     veil_volumetric_desc d = f->plan.volumetric;
     d.medium = lit_medium(f);
     GLuint opv[VEIL_MAX_OPV_TEXTURES];
@@ -461,9 +501,10 @@ static veil_stage_status render_decide(const veil_frame_plan* p, int kept, char*
 
 static veil_result render_build(veil_frame* f, veil_stage_report* rep, veil_error* err)
 {
-    (void)rep;
     const veil_frame_plan* p = &f->plan;
     const veil_render_opts* o = &p->o;
+    veil_result sr = frame_solid(f, err);
+    if (sr != VEIL_OK) return sr;
     GLuint opv[VEIL_MAX_OPV_TEXTURES];
     for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) opv[t] = veil_opv_set_texture(f->parts->opv, t);
     veil_march_desc md = {.medium = lit_medium(f), .camera = o->camera, .width = o->width, .height = o->height,
@@ -471,6 +512,13 @@ static veil_result render_build(veil_frame* f, veil_stage_report* rep, veil_erro
                           .max_distance = o->max_distance, .end_distance = o->behind_distance,
                           .no_background = o->behind != NULL, .field = &f->field};
     md.medium.opv = opv;
+    if (f->solid.voxels) { /* what the lights and the cache saw of the frame's surfaces */
+        size_t len = strlen(rep->why);
+        snprintf(rep->why + len, sizeof rep->why - len, "; the frame's surfaces as a solid (scene/solid.h): "
+                 "%dx%dx%d voxels of %.3g m, %zu solid, %d shadow map%s, made in %.0f ms", f->solid.dims[0],
+                 f->solid.dims[1], f->solid.dims[2], (double)f->solid.voxel, f->solid.solid_count, f->solid.maps,
+                 f->solid.maps == 1 ? "" : "s", f->solid_ms);
+    }
     veil_result res = veil_march_run(f->parts->march, &md, f->images, err);
     if (res == VEIL_OK && o->behind) { /* what is behind, attenuated: T L */
         veil_image_set* im = f->images;

@@ -32,6 +32,7 @@
 #include "../propagate/opv_set.h"
 #include "../render/image_set.h"
 #include "../scene/scene.h"
+#include "../scene/solid.h"
 #include "../volume/sparse.h"
 #include "../volume/volume.h"
 #include "../volumetric/volumetric.h"
@@ -64,6 +65,9 @@ typedef struct veil_render_opts {
      * ends. NULL: the scene's background at infinity. */
     const float* behind;
     const float* behind_distance;
+    /* 1: the surfaces at behind_distance neither shadow the medium nor absorb its light (by default they
+     * do: scene/solid.h) */
+    int behind_not_solid;
 } veil_render_opts;
 
 /* opts (NULL: all defaults) with every zero replaced by what it means for
@@ -186,7 +190,16 @@ typedef struct veil_frame {
     veil_result (*gpu)(struct veil_frame* f, veil_error* err);
     void* gpu_user;
     double gpu_ms; /* the time gpu() spent making the GPU's side: no stage's work, so no stage's time */
+    /* veil fog: the frame's surfaces as a solid (scene/solid.h) and its textures (voxels, shadow maps), made
+     * by the first row that needs them and freed with the frame (veil_frame_end) */
+    veil_solid solid;
+    unsigned int solid_tex[2];
+    int solid_made;
+    double solid_ms;
 } veil_frame;
+
+/* Frees what a frame made for itself (the solid). */
+void veil_frame_end(veil_frame* f);
 
 /* A row of the table. decide() and key() read only the plan and never a
  * GPU; `kept` is 1 when the stage holds a result with this key. */

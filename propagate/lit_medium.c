@@ -3,6 +3,9 @@
 #include <math.h>
 #include <string.h>
 
+#include "../gpu/gl_util.h"
+#include "../scene/solid.h"
+
 static void set3(float dst[4], const float src[3], float w)
 {
     dst[0] = src[0], dst[1] = src[1], dst[2] = src[2], dst[3] = w;
@@ -55,12 +58,51 @@ void veil_lit_medium_fill(const veil_lit_medium* d, veil_medium_block* u)
         u->sun_step[k][1] = (float)d->suns[k].space.nodes[2];
         u->sun_step[k][2] = ceilf(along); /* pieces of at most a voxel, as the prefix sum's panels */
     }
+    const veil_solid* so = d->solid;
+    if (so && so->voxels && d->solid_voxels && d->solid_maps) {
+        set3(u->solid_origin, so->origin, so->voxel);
+        for (int a = 0; a < 3; ++a) u->solid_dims[a] = so->dims[a];
+        u->solid_dims[3] = so->maps < n ? so->maps : n;
+        for (int l = 0; l < u->solid_dims[3]; ++l) {
+            memcpy(u->shadow[3 * l], so->rows[l][0], sizeof u->shadow[0]);
+            memcpy(u->shadow[3 * l + 1], so->rows[l][1], sizeof u->shadow[0]);
+            u->shadow[3 * l + 2][0] = so->bias[l][0], u->shadow[3 * l + 2][1] = so->bias[l][1];
+        }
+    }
 }
 
 void veil_lit_medium_bind_depths(const veil_lit_medium* d)
 {
+    glBindTextureUnit(VEIL_TEX_SOLID, d ? d->solid_voxels : 0);
+    glBindTextureUnit(VEIL_TEX_SHADOW, d ? d->solid_maps : 0);
     for (int t = 0; t < VEIL_MAX_OPV_TEXTURES; ++t) glBindTextureUnit(VEIL_TEX_OPV0 + t, d && d->opv ? d->opv[t] : 0);
     if (d && d->sparse) return; /* the sparse tables hold these units */
     for (int k = 0; k < VEIL_MAX_SUNS; ++k)
         glBindTextureUnit(VEIL_TEX_SUN0 + k, d && d->grid && k < d->sun_count ? d->suns[k].texture : 0);
+}
+
+veil_result veil_lit_medium_solid_textures(const veil_solid* s, GLuint tex[2], veil_error* err)
+{
+    tex[0] = tex[1] = 0;
+    if (!s->voxels) return VEIL_OK;
+    veil_result r = veil_gl_texture3d(GL_R8, s->dims, "veil fog: the frame's solid", &tex[0], err);
+    if (r != VEIL_OK) return r;
+    glTextureParameteri(tex[0], GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(tex[0], GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1); /* rows of dims[0] bytes */
+    glTextureSubImage3D(tex[0], 0, 0, 0, 0, s->dims[0], s->dims[1], s->dims[2], GL_RED, GL_UNSIGNED_BYTE, s->voxels);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &tex[1]);
+    glTextureStorage3D(tex[1], 1, GL_R32F, VEIL_SOLID_MAP, VEIL_SOLID_MAP, s->maps > 0 ? s->maps : 1);
+    glTextureParameteri(tex[1], GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(tex[1], GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    if (s->maps > 0)
+        glTextureSubImage3D(tex[1], 0, 0, 0, 0, VEIL_SOLID_MAP, VEIL_SOLID_MAP, s->maps, GL_RED, GL_FLOAT, s->depth);
+    glObjectLabel(GL_TEXTURE, tex[1], -1, "veil fog: shadow maps of the frame's solid");
+    r = veil_gl_check("veil fog: the frame's solid", err);
+    if (r != VEIL_OK) {
+        glDeleteTextures(2, tex);
+        tex[0] = tex[1] = 0;
+    }
+    return r;
 }

@@ -41,11 +41,20 @@ typedef struct veil_lit_medium {
     const GLuint* opv;            /* VEIL_MAX_OPV_TEXTURES textures (0 where unused) */
     const veil_opv_sun* suns;     /* light-space grids of suns, dense volumes only */
     int sun_count;
+    /* the surfaces of a frame under `veil fog` (scene/solid.h: its grid and shadow maps, one a light in
+     * `lights`' order) and their textures; NULL, 0: none */
+    const struct veil_solid* solid;
+    GLuint solid_voxels, solid_maps;
 } veil_lit_medium;
 
 /* The uniform block for m (exposed so tests can check what the shaders
  * get); each light converted by veil_light_to_gpu (scene/light.h). */
 void veil_lit_medium_fill(const veil_lit_medium* m, veil_medium_block* out);
+
+/* The textures a pass reads a frame's solid from (scene/solid.h): tex[0] its
+ * voxels (r8, 1 where solid), tex[1] its shadow maps (r32f, a layer a light);
+ * both 0 and VEIL_OK when s holds no solid. The caller deletes them. */
+veil_result veil_lit_medium_solid_textures(const struct veil_solid* s, GLuint tex[2], veil_error* err);
 
 /* Binds m's optical depths (OPV textures and, over a dense volume, the
  * light-space grids) for a pass that reads lit_medium.glsl; NULL unbinds

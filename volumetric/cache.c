@@ -6,6 +6,7 @@
 
 #include "../gpu/gl_util.h"
 #include "../gpu/programs.h"
+#include "../scene/solid.h"
 #include "../volume/volume.h"
 
 /* Photons a dispatch traces at most (a long dispatch holds the device). */
@@ -182,12 +183,13 @@ static int cone_source(const veil_gpu_light* l, const float lo[3], const float h
 
 static void unbind_all(void)
 {
-    for (int i = 0; i < 4; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)i, 0);
+    for (int i = 0; i < 5; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)i, 0);
     glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_CACHE, 0);
     glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MEDIUM, 0);
     glBindImageTexture(VEIL_IMAGE_CACHE, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindTextureUnit(VEIL_TEX_EV, 0);
     glBindTextureUnit(VEIL_TEX_EMISSION, 0);
+    glBindTextureUnit(VEIL_TEX_SOLID, 0);
     glUseProgram(0);
 }
 
@@ -231,7 +233,7 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     b.scale[2] = (float)(1.0 / volume);
     b.seed[0] = s->seed;
 
-    GLuint buf[4] = {0, 0, 0, 0}; /* sums, cells, emitters, counts */
+    GLuint buf[5] = {0, 0, 0, 0, 0}; /* sums, cells, emitters, counts, free parts */
     GLuint medium_ubo = 0;
     float* cellv = NULL;
     uint32_t* emit = NULL;
@@ -244,13 +246,38 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     if (r == VEIL_OK)
         r = veil_gl_buffer(NULL, (4 + VEIL_CACHE_ENERGY_WORDS) * sizeof(uint32_t), GL_DYNAMIC_STORAGE_BIT,
                            "veil cache counts", &buf[3], err);
+    if (r == VEIL_OK) { /* each cell's part outside a frame's solid (veil fog): 4^3 points a cell */
+        float* fr = malloc(cells * sizeof *fr);
+        if (!fr) r = veil_fail(err, VEIL_ERR_OOM, "out of memory for the light cache's cells");
+        for (size_t k = 0; fr && k < cells; ++k) {
+            fr[k] = 1.0f;
+            if (!md->solid || !md->solid->voxels) continue;
+            int c[3] = {(int)(k % (size_t)dims[0]), (int)(k / (size_t)dims[0] % (size_t)dims[1]),
+                        (int)(k / ((size_t)dims[0] * dims[1]))};
+            int apart = 0; /* a cell off the solid's box is free */
+            for (int a = 0; a < 3; ++a) {
+                float c0 = lo[a] + (float)c[a] * h, s0 = md->solid->origin[a];
+                apart |= c0 + h < s0 || c0 > s0 + (float)md->solid->dims[a] * md->solid->voxel;
+            }
+            if (apart) continue;
+            int in = 0;
+            for (int q = 0; q < 64; ++q) {
+                float x[3];
+                for (int a = 0; a < 3; ++a) x[a] = lo[a] + ((float)c[a] + (((q >> (2 * a)) & 3) + 0.5f) / 4.0f) * h;
+                in += veil_solid_at(md->solid, x);
+            }
+            fr[k] = 1.0f - (float)in / 64.0f;
+        }
+        if (fr) r = veil_gl_buffer(fr, cells * sizeof *fr, 0, "veil cache free parts", &buf[4], err);
+        free(fr);
+    }
     const int stacked[3] = {dims[0], dims[1], 4 * dims[2]};
     if (r == VEIL_OK) r = field_texture(stacked, "veil light cache (fluence, flux)", tex, err);
     if (r != VEIL_OK) goto done;
     static const uint32_t zero = 0;
     glClearNamedBufferData(buf[0], GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glClearNamedBufferData(buf[3], GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-    rep->bytes = (double)cells * (VEIL_CACHE_WORDS * 4.0 + 8.0 + 64.0); /* sums, cells, the texture */
+    rep->bytes = (double)cells * (VEIL_CACHE_WORDS * 4.0 + 12.0 + 64.0); /* sums, cells, free parts, the texture */
 
     /* 1. the cells' majorants (and emission weights) */
     r = veil_gl_buffer(mu, sizeof *mu, 0, "veil cache medium block", &medium_ubo, err);
@@ -261,6 +288,7 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     if (sparse) veil_ev_sparse_bind(md->sparse);
     glBindTextureUnit(VEIL_TEX_EV, md->grid ? md->ev : 0);
     glBindTextureUnit(VEIL_TEX_EMISSION, emission ? md->emission : 0);
+    glBindTextureUnit(VEIL_TEX_SOLID, md->solid_voxels); /* a frame's surfaces absorb photons (scene/solid.h) */
     for (int i = 0; i < 4; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)i, buf[i]);
     glUseProgram(p->bounds[sparse]);
     glDispatchCompute(veil_groups(dims[0], VEIL_CACHE_CELL_GROUP), veil_groups(dims[1], VEIL_CACHE_CELL_GROUP),
@@ -411,6 +439,7 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
 
     /* 4. the sums turned into the fields */
     glUseProgram(p->resolve);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_CACHE_FREE, buf[4]);
     glBindImageTexture(VEIL_IMAGE_CACHE, *tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glDispatchCompute(veil_groups(dims[0], VEIL_CACHE_CELL_GROUP), veil_groups(dims[1], VEIL_CACHE_CELL_GROUP),
                       veil_groups(dims[2], VEIL_CACHE_CELL_GROUP));
@@ -456,7 +485,7 @@ done:
     free(emit);
     unbind_all();
     if (sparse) veil_ev_sparse_bind(NULL);
-    glDeleteBuffers(4, buf);
+    glDeleteBuffers(5, buf);
     glDeleteBuffers(1, &medium_ubo);
     if (r != VEIL_OK) {
         glDeleteTextures(1, tex);

@@ -85,9 +85,71 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
 #endif
 }
 
+// The surfaces of a frame under `veil fog` (scene/solid.h): solid voxels,
+// and per light the distance along its path to the first of them.
+layout(binding = VEIL_TEX_SOLID) uniform sampler3D u_solid;
+layout(binding = VEIL_TEX_SHADOW) uniform sampler2DArray u_shadow;
+
+// Unit directions on [0, 1]^2, octahedrally (scene/solid.c: oct_encode).
+vec2 oct_encode(vec3 w)
+{
+    vec2 p = w.xy / (abs(w.x) + abs(w.y) + abs(w.z));
+    if (w.z < 0.0) p = (1.0 - abs(p.yx)) * vec2(p.x >= 0.0 ? 1.0 : -1.0, p.y >= 0.0 ? 1.0 : -1.0);
+    return 0.5 * p + 0.5;
+}
+
+// How much of light l reaches x past the frame's solid: its shadow map's
+// four nearest texels, each lit where x is no further along the light's
+// path than the first solid (plus the bias), weighted bilinearly
+// (veil_solid_visibility computes the same).
+float solid_visibility(int l, vec3 x)
+{
+    if (l >= med.solid_dims.w) return 1.0;
+    vec2 uv;
+    float dist;
+    if (int(med.lights[l].position.w) == VEIL_LIGHT_DIRECTIONAL) {
+        vec4 p = vec4(x, 1.0);
+        uv = vec2(dot(med.shadow[3 * l], p), dot(med.shadow[3 * l + 1], p));
+        if (!(all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))))) return 1.0;
+        dist = dot(x, med.lights[l].direction.xyz);
+    } else {
+        vec3 w = x - med.lights[l].position.xyz;
+        dist = length(w);
+        if (!(dist > 0.0)) return 1.0;
+        uv = oct_encode(w / dist);
+    }
+    float bias = med.shadow[3 * l + 2].x + med.shadow[3 * l + 2].y * dist;
+    vec2 f = uv * float(VEIL_SOLID_MAP) - 0.5, f0 = floor(f), a = f - f0;
+    ivec2 i0 = clamp(ivec2(f0), ivec2(0), ivec2(VEIL_SOLID_MAP - 1));
+    ivec2 i1 = clamp(ivec2(f0) + 1, ivec2(0), ivec2(VEIL_SOLID_MAP - 1));
+    vec4 lit = vec4(dist <= texelFetch(u_shadow, ivec3(i0.x, i0.y, l), 0).r + bias ? 1.0 : 0.0,
+                    dist <= texelFetch(u_shadow, ivec3(i1.x, i0.y, l), 0).r + bias ? 1.0 : 0.0,
+                    dist <= texelFetch(u_shadow, ivec3(i0.x, i1.y, l), 0).r + bias ? 1.0 : 0.0,
+                    dist <= texelFetch(u_shadow, ivec3(i1.x, i1.y, l), 0).r + bias ? 1.0 : 0.0);
+    return mix(mix(lit.x, lit.y, a.x), mix(lit.z, lit.w, a.x), a.y);
+}
+
+// The first solid along p + t d, t in [0, t_max] (d unit): samples every
+// half voxel from where the path enters the solid's box, the first a
+// quarter voxel in (veil_solid_hit steps the same); t_max where none.
+float solid_hit(vec3 p, vec3 d, float t_max)
+{
+    float h = med.solid_origin.w;
+    if (!(h > 0.0)) return t_max;
+    vec3 lo = med.solid_origin.xyz;
+    vec2 s = box_hit(p, d, lo, lo + vec3(med.solid_dims.xyz) * h, 0.0, t_max);
+    for (float t = s.x + 0.25 * h; t < s.y; t += 0.5 * h) {
+        ivec3 c = ivec3(floor((p + d * t - lo) / h));
+        if (all(greaterThanEqual(c, ivec3(0))) && all(lessThan(c, med.solid_dims.xyz)) && texelFetch(u_solid, c, 0).r > 0.0)
+            return t;
+    }
+    return t_max;
+}
+
 // Light l at x before the medium: the direction it travels, its irradiance
-// E (W/m^2: I / r^2 for point and spot lights, with the cone; a sun's own)
-// and the distance to it (INF for a sun). False when it adds nothing here.
+// E (W/m^2: I / r^2 for point and spot lights, with the cone; a sun's own;
+// less what a frame's surfaces shadow) and the distance to it (INF for a
+// sun). False when it adds nothing here.
 bool light_at(int l, vec3 x, out vec3 travel, out vec3 E, out float len)
 {
     if (int(med.lights[l].position.w) != VEIL_LIGHT_DIRECTIONAL) {
@@ -104,6 +166,7 @@ bool light_at(int l, vec3 x, out vec3 travel, out vec3 E, out float len)
         E = med.lights[l].color.rgb;
         len = INF;
     }
+    if (med.solid_origin.w > 0.0) E *= solid_visibility(l, x);
     return max(E.r, max(E.g, E.b)) > 0.0;
 }
 

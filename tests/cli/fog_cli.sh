@@ -30,6 +30,24 @@ rmax=$(awk '$1 == "R" {print $5}' "$dir/stats.txt")
 awk -v m="$rmax" 'BEGIN { exit !(m > 0.9 && m < 1.57) }' || { echo "FAIL: R max $rmax: expected the surface (R = 2) attenuated"; fail=1; }
 check 0 "channel depth.Z" "$dir/depthz.exr" --scene "$dir/fog_scene.json" -o "$dir/out2.exr"
 check 0 "as distance along the ray" "$dir/sky.exr" --scene "$dir/fog_scene.json" -o "$dir/out3.exr" --depth-is distance
+# the wall (Z = 5) shadows the fog before it from a sun beyond it (scene/solid.h): R on the axis is the
+# surface, exp(-0.35 x 5) 2 = 0.348, and the fog adds nearly nothing; with --no-occluders the lit fog adds
+# sigma_s E p(1) 5 exp(-0.35 x 5.2) = 0.3 x 5 x 0.211 x 5 x 0.162 = 0.256 (the sun's path to the box's far
+# face is 5.2 - t, the camera's t: their sum is constant)
+cat > "$dir/sun_scene.json" <<'JSON'
+{"camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "fov_y_deg": 30, "width": 32, "height": 24},
+ "medium": {"sigma_a": [0.05, 0.05, 0.05], "sigma_s": [0.3, 0.3, 0.3], "phase": {"type": "hg", "g": 0.3},
+  "sources": [{"type": "exponential", "density": 1, "falloff": 0, "direction": [0, 1, 0], "origin": [0, 0, 0],
+               "bounds": [[-20, -20, -5.2], [20, 20, 1]]}]},
+ "lights": [{"type": "directional", "direction": [0, 0, 1], "irradiance": [5, 5, 5]}],
+ "multiple_scattering": {"screen_space": false, "volumetric": false}}
+JSON
+check 0 "depth from channel Z" "$dir/good.exr" --scene "$dir/sun_scene.json" -o "$dir/shadowed.exr"
+check 0 "depth from channel Z" "$dir/good.exr" --scene "$dir/sun_scene.json" -o "$dir/lit.exr" --no-occluders
+r_dark=$("$STATS" "$dir/shadowed.exr" | awk '$1 == "R" {print $5}')
+r_lit=$("$STATS" "$dir/lit.exr" | awk '$1 == "R" {print $5}')
+awk -v d="$r_dark" -v l="$r_lit" 'BEGIN { exit !(d < 0.36 && l > 0.55) }' ||
+    { echo "FAIL: R max $r_dark shadowed by the wall (want < 0.36), $r_lit with --no-occluders (want > 0.55)"; fail=1; }
 echo keep > "$dir/keep.exr"
 check 1 "no depth channel" "$dir/noz.exr" --scene "$dir/fog_scene.json" -o "$dir/keep.exr"
 # issue 22: a depth channel of uint is named as such, not "no depth channel"

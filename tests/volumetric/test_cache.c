@@ -43,7 +43,24 @@
  *    compared; a photon's channel weights sum to a constant
  *    (cache_trace.comp), so albedo 1 conserves each photon's sum exactly
  *    but for the fixed point's and the floats' rounding (Hoeffding over the
- *    photons, derived where it is checked). */
+ *    photons, derived where it is checked).
+ * 5. A frame's surfaces absorb photons (veil fog: scene/solid.h): the fog
+ *    box of 4 (albedo 1, chromatic sigma_s, HG 0.5) under the sun straight
+ *    down, over a floor at y = 0 seen by a camera above it. A photon that
+ *    reaches the floor before it scatters is gone (never counted); one that
+ *    scatters is counted once, and then leaves the grid or ends in the
+ *    floor. Against an analog Monte Carlo of the same slab on the CPU (per
+ *    channel: the fraction of what scattered that the floor absorbs, a
+ *    binomial with its standard error) at the floor's lowest and highest
+ *    height as the photons meet it (vertical paths stepped at half a voxel
+ *    over the solid's top: within half a voxel below it): the GPU's fraction
+ *    lies between the two within 5.5 combined standard errors (the groups'
+ *    spread, as in 4). Without the floor it would be 0 (albedo 1). What
+ *    scattered is E A (1 - exp(-sigma_s (1 - y))) for y between those
+ *    heights, and what scattered = what left + what was absorbed. The cells
+ *    in the floor hold no track: the fluence of each cell times the volume
+ *    of its part outside the solid (at least VEIL_CACHE_MIN_FREE of it,
+ *    4^3 points a cell) sums to the track length, as in 4. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -52,6 +69,7 @@
 #include "support/check.h"
 #include "frame/renderer.h"
 #include "reference/pathtracer.h"
+#include "scene/solid.h"
 #include "volumetric/volumetric.h"
 
 static void fixed_point(void)
@@ -165,6 +183,17 @@ static double group_sum(const veil_cache_report* c, int n, const int* kind, cons
     return mean * G;
 }
 
+/* How far the cells' fluence times volume may be from the photons' track length (4 says why): the fixed
+ * point's rounding (Hoeffding) and the floats'. A: the sun's cross-section, h: the cell. */
+static double track_tolerance(const veil_cache_report* c, double A, double h, double track)
+{
+    double phi_max = 3.0 * A / (double)c->photons;
+    double unit_cells = 3.0 * phi_max * sqrt(3.0) * h / 1048576.0, unit_acc = 65536.0 * unit_cells;
+    double n_cells = (double)c->photons * (c->cap + 1.0), n_acc = (double)c->photons;
+    return 2.0 * sqrt(2.0 * log(2.0 / 1e-9)) * (sqrt(n_cells) * unit_cells + sqrt(n_acc) * unit_acc) +
+           (c->cap * ldexp(1.0, -24) + 1728.0 * 6e-8) * track;
+}
+
 static void energy(veil_volumetric* d)
 {
     veil_error err = {0};
@@ -234,11 +263,7 @@ static void energy(veil_volumetric* d)
              * floats: a photon's track length is a float sum of at most cap pieces (recursive summation of
              * positive terms: within cap 2^-24 of it), and each cell a float in the texture (2^-24 of it;
              * 1728 cells taken at 6e-8 of the whole, a bound as loose) */
-            double phi_max = 3.0 * A / (double)c->photons, h = 2.0 / 12.0;
-            double unit_cells = 3.0 * phi_max * sqrt(3.0) * h / 1048576.0, unit_acc = 65536.0 * unit_cells;
-            double n_cells = (double)c->photons * (c->cap + 1.0), n_acc = (double)c->photons;
-            double tol_t = 2.0 * sqrt(2.0 * log(2.0 / 1e-9)) * (sqrt(n_cells) * unit_cells + sqrt(n_acc) * unit_acc) +
-                           (c->cap * ldexp(1.0, -24) + 1728.0 * 6e-8) * track;
+            double tol_t = track_tolerance(c, A, 2.0 / 12.0, track);
             CHECK(fabs(cells - track) <= tol_t, "channel %d: the cells' fluence times volume %.9g W m, the photons' "
                   "track length %.9g: off by %.3g > %.3g", ch, cells, track, cells - track, tol_t);
             /* the later light alone (its pieces are a subset of the same adds: the same bound holds) */
@@ -288,6 +313,153 @@ static void energy(veil_volumetric* d)
         free(phi);
         free(later);
     }
+}
+
+static unsigned mc_state = 99u;
+static double mc_rnd(void)
+{
+    mc_state = mc_state * 1664525u + 1013904223u;
+    return ((double)(mc_state >> 8) + 0.5) / 16777216.0;
+}
+
+/* The analog walk of 5 on the CPU, one channel: photons in through the top of [-1, 1]^3 going down, scattered
+ * (HG g) at rate sigma_s, absorbed by the floor at y_floor, gone through the box's other faces. The fraction of
+ * those that scattered that the floor absorbs, and its standard error. */
+static double mc_floor(double sigma_s, double g, double y_floor, int n, double* se)
+{
+    long scattered = 0, absorbed = 0;
+    for (int i = 0; i < n; ++i) {
+        double p[3] = {2.0 * mc_rnd() - 1.0, 1.0, 2.0 * mc_rnd() - 1.0}, d[3] = {0.0, -1.0, 0.0};
+        double t = -log(mc_rnd()) / sigma_s;
+        if (1.0 - t <= y_floor) continue;
+        p[1] -= t;
+        ++scattered;
+        for (;;) {
+            /* HG about d */
+            double xi = mc_rnd(), s = (1.0 - g * g) / (1.0 - g + 2.0 * g * xi);
+            double ct = (1.0 + g * g - s * s) / (2.0 * g), st = sqrt(fmax(0.0, 1.0 - ct * ct)), ph = 6.283185307179586 * mc_rnd();
+            double a[3] = {fabs(d[0]) < 0.9 ? 1.0 : 0.0, fabs(d[0]) < 0.9 ? 0.0 : 1.0, 0.0}, u[3], v[3];
+            u[0] = d[1] * a[2] - d[2] * a[1], u[1] = d[2] * a[0] - d[0] * a[2], u[2] = d[0] * a[1] - d[1] * a[0];
+            double un = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+            for (int k = 0; k < 3; ++k) u[k] /= un;
+            v[0] = d[1] * u[2] - d[2] * u[1], v[1] = d[2] * u[0] - d[0] * u[2], v[2] = d[0] * u[1] - d[1] * u[0];
+            for (int k = 0; k < 3; ++k) d[k] = ct * d[k] + st * (cos(ph) * u[k] + sin(ph) * v[k]);
+            /* to the floor, to the box's faces */
+            double t_floor = d[1] < 0.0 ? (p[1] - y_floor) / -d[1] : INFINITY, t_box = INFINITY;
+            for (int k = 0; k < 3; ++k)
+                if (d[k] != 0.0) t_box = fmin(t_box, ((d[k] > 0.0 ? 1.0 : -1.0) - p[k]) / d[k]);
+            t = -log(mc_rnd()) / sigma_s;
+            if (t >= fmin(t_floor, t_box)) {
+                absorbed += t_floor < t_box;
+                break;
+            }
+            for (int k = 0; k < 3; ++k) p[k] += t * d[k];
+        }
+    }
+    double f = (double)absorbed / (double)scattered;
+    *se = sqrt(f * (1.0 - f) / (double)scattered);
+    return f;
+}
+
+static void floor_absorbs(veil_volumetric* d)
+{
+    veil_error err = {0};
+    veil_source fog = fog_box();
+    veil_light sun = {.type = VEIL_LIGHT_DIRECTIONAL, .direction = {0.0f, -1.0f, 0.0f}, .color = {1.0f, 2.0f, 3.0f}};
+    veil_scene s = {0};
+    const float sigma_s[3] = {1.0f, 0.6f, 0.3f}, g = 0.5f;
+    for (int c = 0; c < 3; ++c) s.medium.sigma_s[c] = sigma_s[c];
+    s.medium.phase = (veil_phase){.type = VEIL_PHASE_HG, .g = g};
+    s.medium.sources = &fog;
+    s.medium.source_count = 1;
+    veil_multiple_defaults(&s.multiple);
+    /* the floor, seen from 3 m above: each pixel's distance to y = 0 */
+    enum { FW = 64 };
+    veil_camera cam = {.position = {0, 3, 0}, .look_at = {0, 0, 0}, .up = {0, 0, -1}, .fov_y_deg = 60.0f,
+                       .width = FW, .height = FW};
+    veil_camera_basis b;
+    CHECK(veil_camera_make_basis(&cam, FW, FW, &b, &err) == VEIL_OK, "%s", err.msg);
+    float* dist = malloc(sizeof(float) * FW * FW);
+    for (int y = 0; y < FW; ++y)
+        for (int x = 0; x < FW; ++x) {
+            float w[3];
+            veil_camera_ray(&b, FW, FW, x, y, w);
+            dist[y * FW + x] = 3.0f / -w[1];
+        }
+    veil_solid so;
+    CHECK(veil_solid_build(&cam, FW, FW, dist, fog.fog.bounds[0], fog.fog.bounds[1], &sun, 1, &so, &err) == VEIL_OK &&
+              so.voxels, "the floor's solid: %s", err.msg);
+    free(dist);
+    if (!so.voxels) return;
+    /* the floor's height as vertical paths meet it, and within half a voxel below */
+    double y_lo = INFINITY, y_hi = -INFINITY;
+    const float down[3] = {0.0f, -1.0f, 0.0f};
+    for (int j = 0; j < 40; ++j)
+        for (int i = 0; i < 40; ++i) {
+            float p[3] = {-0.99f + 1.98f * (float)i / 39.0f, 1.0f, -0.99f + 1.98f * (float)j / 39.0f};
+            double y = 1.0 - veil_solid_hit(&so, p, down, 2.0f);
+            y_lo = fmin(y_lo, y), y_hi = fmax(y_hi, y);
+        }
+    y_lo -= 0.5 * so.voxel, y_hi += 0.5 * so.voxel;
+    CHECK(y_lo > -0.1 && y_hi < 0.1, "the floor is at y = 0: met between %g and %g", y_lo, y_hi);
+    GLuint tex[2] = {0, 0}, opv[VEIL_MAX_OPV_TEXTURES] = {0};
+    CHECK(veil_lit_medium_solid_textures(&so, tex, &err) == VEIL_OK, "%s", err.msg);
+    veil_volumetric_desc vd = {.kind = VEIL_FIELD_CACHE,
+                               .medium = {.scene = &s, .lights = &sun, .light_count = 1, .opv = opv, .solid = &so,
+                                          .solid_voxels = tex[0], .solid_maps = tex[1]},
+                               .cache = {.photons = 1 << 18, .cells = 12, .seed = 13}};
+    veil_volumetric_field f;
+    veil_volumetric_report rep;
+    CHECK(veil_volumetric_update(d, &vd, 400, &f, &rep, &err) == VEIL_OK, "%s", err.msg);
+    const veil_cache_report* c = &rep.cache;
+    int dims[3] = {0, 0, 0};
+    float* phi = veil_volumetric_readback(d, dims);
+    CHECK(c->cut == 0 && c->misses == 0 && phi && dims[0] == 12 && dims[1] == 12 && dims[2] == 12,
+          "the floor's cache: %u cut, %u misses, %dx%dx%d cells", c->cut, c->misses, dims[0], dims[1], dims[2]);
+    /* each cell's part outside the solid */
+    const double h = 2.0 / 12.0, V = h * h * h;
+    double free_part[12 * 12 * 12];
+    for (int k = 0; k < 12 * 12 * 12; ++k) {
+        int cc[3] = {k % 12, k / 12 % 12, k / 144}, in = 0;
+        for (int q = 0; q < 64; ++q) {
+            float x[3];
+            for (int a = 0; a < 3; ++a) x[a] = -1.0f + ((float)cc[a] + (((q >> (2 * a)) & 3) + 0.5f) / 4.0f) * (float)h;
+            in += veil_solid_at(&so, x);
+        }
+        free_part[k] = fmax(1.0 - in / 64.0, VEIL_CACHE_MIN_FREE);
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+        double se_g, se_lo, se_hi;
+        const int k_in[1] = {VEIL_CACHE_ENERGY_IN}, k_ab[1] = {VEIL_CACHE_ENERGY_ABSORBED};
+        const int k_bal[3] = {VEIL_CACHE_ENERGY_IN, VEIL_CACHE_ENERGY_OUT, VEIL_CACHE_ENERGY_ABSORBED};
+        const double one[1] = {1.0}, bal_k[3] = {1.0, -1.0, -1.0};
+        double in = group_sum(c, 1, k_in, one, ch, &se_g);
+        double want_lo = sun.color[ch] * 4.0 * (1.0 - exp(-sigma_s[ch] * (1.0 - y_hi)));
+        double want_hi = sun.color[ch] * 4.0 * (1.0 - exp(-sigma_s[ch] * (1.0 - y_lo)));
+        CHECK(in >= want_lo - 5.5 * se_g && in <= want_hi + 5.5 * se_g, "floor, channel %d: scattered %.6g W, "
+              "closed form %.6g .. %.6g (5.5 se %.3g)", ch, in, want_lo, want_hi, 5.5 * se_g);
+        double bal = group_sum(c, 3, k_bal, bal_k, ch, &se_g);
+        CHECK(fabs(bal) <= 5.5 * se_g, "floor, channel %d: scattered - left - absorbed = %.3g > %.3g", ch, bal,
+              5.5 * se_g);
+        double ab = group_sum(c, 1, k_ab, one, ch, &se_g);
+        double frac = ab / in, se_frac = se_g / in; /* in's own spread is small beside it: a ratio of sums */
+        double f_lo = mc_floor(sigma_s[ch], g, y_hi, 400000, &se_lo), f_hi = mc_floor(sigma_s[ch], g, y_lo, 400000, &se_hi);
+        double lo = fmin(f_lo, f_hi) - 5.5 * sqrt(se_frac * se_frac + se_lo * se_lo);
+        double hi = fmax(f_lo, f_hi) + 5.5 * sqrt(se_frac * se_frac + se_hi * se_hi);
+        CHECK(frac >= lo && frac <= hi, "floor, channel %d: the floor absorbs %.5f of what scattered; the CPU walk "
+              "%.5f .. %.5f (allowed %.5f .. %.5f)", ch, frac, f_lo, f_hi, lo, hi);
+        double cells = 0.0, track = c->energy[VEIL_CACHE_ENERGY_TRACK][ch];
+        for (int k = 0; k < 12 * 12 * 12; ++k) cells += phi[4 * k + ch] * V * free_part[k];
+        double tol_t = track_tolerance(c, 4.0, h, track);
+        CHECK(fabs(cells - track) <= tol_t, "floor, channel %d: the cells' fluence times their free volume %.9g W m, "
+              "the track %.9g: off by %.3g > %.3g", ch, cells, track, cells - track, tol_t);
+        printf("floor, channel %d: scattered %.5g W (closed form %.5g .. %.5g), the floor absorbs %.4f of it (CPU "
+               "walk %.4f .. %.4f, se %.4f / %.4f); cells x free volume %.7g, track %.7g\n", ch, in, want_lo, want_hi,
+               frac, f_lo, f_hi, se_frac, se_lo, cells, track);
+    }
+    free(phi);
+    glDeleteTextures(2, tex);
+    veil_solid_free(&so);
 }
 
 static double image_mean(const float* rgba, int n, int stride)
@@ -373,6 +545,7 @@ int main(void)
     CHECK(veil_volumetric_create(&d, &err) == VEIL_OK, "%s", err.msg);
     if (d) determinism(d);
     if (d) energy(d);
+    if (d) floor_absorbs(d);
     veil_volumetric_destroy(d);
     no_double_count(gl);
     veil_gl_destroy(gl);

@@ -153,6 +153,8 @@ vec3 scatter_hg(vec3 d, float g)
 }
 
 // Photon n, from its start to its end; a photon cut at the step cap is counted, its account left out.
+// Where a frame's surfaces are given (veil fog), a photon that meets them is absorbed there: the
+// light they send back is the frame's, spread by the screen-space pass.
 void trace(uint n)
 {
     float h = cb.origin.w;
@@ -210,6 +212,16 @@ void trace(uint n)
         uint k = uint(c.x) + uint(cb.dims.x) * (uint(c.y) + uint(cb.dims.y) * uint(c.z));
         float maj = cells[k].x * cb.scale.w;
         if (maj > 0.0) maj = max(maj, cb.sigma_a.w);
+        // a frame's surface (veil fog, scene/solid.h) before the next collision or the cell's side absorbs it
+        float t_next = maj * t_exit <= tau ? t_exit : tau / maj;
+        float t_solid = solid_hit(pos, dir, t_next);
+        if (t_solid < t_next) {
+            if (scored) {
+                visit(c, w, dir, t_solid, odd);
+                acc_absorbed = w;
+            }
+            break;
+        }
         if (maj * t_exit <= tau) { // no collision in the cell: on to the next
             if (scored) visit(c, w, dir, t_exit, odd);
             flush(c, odd);
