@@ -10,20 +10,33 @@
 #include "../gpu/programs.h"
 #include "../scene/camera.h"
 
+/* The march's variants: march.comp with VEIL_SPARSE (a sparse volume), VEIL_MARCH_EMISSION (the volume
+ * glows) and VEIL_SOLID (a frame's surfaces shadow the lights: scene/solid.h) defined or not, program[] at
+ * 4 sparse + 2 emission + solid. The first two are made with the march, the rest when first needed. */
+enum { MARCH_SPARSE = 4, MARCH_EMISSION = 2, MARCH_SOLID = 1, MARCH_VARIANTS = 8 };
+
 struct veil_march {
-    GLuint program, program_emission, ubo, medium_ubo; /* the march, and its variant with emission */
-    GLuint program_sparse[2];              /* over a sparse volume (and with emission), made when first needed */
+    GLuint program[MARCH_VARIANTS], ubo, medium_ubo;
 };
+
+static veil_result variant(veil_march* m, int v, veil_error* err)
+{
+    if (m->program[v]) return VEIL_OK;
+    if (v == 0) return veil_gpu_program("render/shaders/march.comp", &m->program[0], err);
+    char defines[128] = "", name[64] = "";
+    if (v & MARCH_SPARSE) strcat(defines, "#define VEIL_SPARSE 1\n"), strcat(name, "sparse");
+    if (v & MARCH_EMISSION) strcat(defines, "#define VEIL_MARCH_EMISSION 1\n"), strcat(name, *name ? ", emission" : "emission");
+    if (v & MARCH_SOLID) strcat(defines, "#define VEIL_SOLID 1\n"), strcat(name, *name ? ", solid" : "solid");
+    return veil_gpu_program_variant("render/shaders/march.comp", defines, name, &m->program[v], err);
+}
 
 veil_result veil_march_create(veil_march** out, veil_error* err)
 {
     *out = NULL;
     veil_march* m = calloc(1, sizeof *m);
     if (!m) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the ray marcher");
-    veil_result r = veil_gpu_program("render/shaders/march.comp", &m->program, err);
-    if (r == VEIL_OK) /* the emission variant: the same file with VEIL_MARCH_EMISSION defined */
-        r = veil_gpu_program_variant("render/shaders/march.comp", "#define VEIL_MARCH_EMISSION 1\n", "emission",
-                                     &m->program_emission, err);
+    veil_result r = variant(m, 0, err);
+    if (r == VEIL_OK) r = variant(m, MARCH_EMISSION, err);
     if (r == VEIL_OK)
         r = veil_gl_buffer(NULL, sizeof(veil_march_block), GL_DYNAMIC_STORAGE_BIT, "veil march block", &m->ubo, err);
     if (r == VEIL_OK)
@@ -40,10 +53,7 @@ veil_result veil_march_create(veil_march** out, veil_error* err)
 void veil_march_destroy(veil_march* m)
 {
     if (!m) return;
-    glDeleteProgram(m->program);
-    glDeleteProgram(m->program_emission);
-    glDeleteProgram(m->program_sparse[0]);
-    glDeleteProgram(m->program_sparse[1]);
+    for (int v = 0; v < MARCH_VARIANTS; ++v) glDeleteProgram(m->program[v]);
     glDeleteBuffers(1, &m->ubo);
     glDeleteBuffers(1, &m->medium_ubo);
     free(m);
@@ -159,15 +169,12 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         out->width = w, out->height = h;
         glNamedBufferSubData(m->ubo, 0, sizeof u, &u);
         glNamedBufferSubData(m->medium_ubo, 0, sizeof mu, &mu);
-        int e = lm->emission != 0;
-        if (lm->grid && lm->sparse && !m->program_sparse[e])
-            r = veil_gpu_program_variant("render/shaders/march.comp",
-                                         e ? "#define VEIL_SPARSE 1\n#define VEIL_MARCH_EMISSION 1\n" : "#define VEIL_SPARSE 1\n",
-                                         e ? "sparse, emission" : "sparse", &m->program_sparse[e], err);
     }
+    const int v = (lm->grid && lm->sparse ? MARCH_SPARSE : 0) + (lm->grid && lm->emission ? MARCH_EMISSION : 0) +
+                  (mu.solid_origin[3] > 0.0f ? MARCH_SOLID : 0);
+    if (r == VEIL_OK) r = variant(m, v, err);
     if (r == VEIL_OK) {
-        glUseProgram(lm->grid && lm->sparse ? m->program_sparse[lm->emission != 0]
-                     : lm->grid && lm->emission ? m->program_emission : m->program);
+        glUseProgram(m->program[v]);
         veil_ev_sparse_bind(lm->grid ? lm->sparse : NULL);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, m->ubo);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MEDIUM, m->medium_ubo);

@@ -12,9 +12,11 @@
 /* Photons a dispatch traces at most (a long dispatch holds the device). */
 #define CACHE_DISPATCH_PHOTONS (1 << 18)
 
-static const char* const SPARSE_DEFINE = "#define VEIL_SPARSE 1\n";
+#define SPARSE_DEFINE_TEXT "#define VEIL_SPARSE 1\n"
+#define SOLID_DEFINE_TEXT "#define VEIL_SOLID 1\n"
+static const char* const SPARSE_DEFINE = SPARSE_DEFINE_TEXT;
 
-veil_result veil__cache_programs(veil_cache_programs* p, int sparse, veil_error* err)
+veil_result veil__cache_programs(veil_cache_programs* p, int sparse, int solid, veil_error* err)
 {
     veil_result r = VEIL_OK;
     if (!p->resolve) r = veil_gpu_program("volumetric/shaders/cache_resolve.comp", &p->resolve, err);
@@ -24,19 +26,22 @@ veil_result veil__cache_programs(veil_cache_programs* p, int sparse, veil_error*
         r = sparse ? veil_gpu_program_variant("volumetric/shaders/cache_bounds.comp", SPARSE_DEFINE, "sparse",
                                               &p->bounds[1], err)
                    : veil_gpu_program("volumetric/shaders/cache_bounds.comp", &p->bounds[0], err);
-    if (r == VEIL_OK && !p->trace[sparse])
-        r = sparse ? veil_gpu_program_variant("volumetric/shaders/cache_trace.comp", SPARSE_DEFINE, "sparse",
-                                              &p->trace[1], err)
-                   : veil_gpu_program("volumetric/shaders/cache_trace.comp", &p->trace[0], err);
+    const int t = 2 * solid + sparse;
+    if (r == VEIL_OK && !p->trace[t]) {
+        static const char* const defines[4] = {"", SPARSE_DEFINE_TEXT, SOLID_DEFINE_TEXT,
+                                               SPARSE_DEFINE_TEXT SOLID_DEFINE_TEXT};
+        static const char* const names[4] = {"", "sparse", "solid", "sparse, solid"};
+        r = t == 0 ? veil_gpu_program("volumetric/shaders/cache_trace.comp", &p->trace[0], err)
+                   : veil_gpu_program_variant("volumetric/shaders/cache_trace.comp", defines[t], names[t], &p->trace[t],
+                                              err);
+    }
     return r;
 }
 
 void veil__cache_programs_free(veil_cache_programs* p)
 {
-    for (int i = 0; i < 2; ++i) {
-        glDeleteProgram(p->bounds[i]);
-        glDeleteProgram(p->trace[i]);
-    }
+    for (int i = 0; i < 2; ++i) glDeleteProgram(p->bounds[i]);
+    for (int i = 0; i < 4; ++i) glDeleteProgram(p->trace[i]);
     glDeleteProgram(p->resolve);
     glDeleteBuffers(1, &p->ubo);
     memset(p, 0, sizeof *p);
@@ -210,7 +215,8 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     memset(rep, 0, sizeof *rep);
     *tex = 0;
     const int sparse = md->grid && md->sparse;
-    veil_result r = veil__cache_programs(p, sparse, err);
+    const int solid = md->solid && md->solid->voxels && md->solid_voxels;
+    veil_result r = veil__cache_programs(p, sparse, solid, err);
     if (r != VEIL_OK) return r;
     const size_t cells = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
     const int emission = s->emission && md->grid && md->emission;
@@ -412,7 +418,7 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     /* the energy account: a photon's channel weight is at most 3 phi_max, 2^VEIL_CACHE_FIXED_BITS units */
     /* (as the shader holds it: a float) */
     const double units_e = (float)(phi_max > 0.0 ? ldexp(1.0, VEIL_CACHE_FIXED_BITS) / (3.0 * phi_max) : 1.0);
-    glUseProgram(p->trace[sparse]);
+    glUseProgram(p->trace[2 * solid + sparse]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_CACHE_EMIT, buf[2]);
     for (int j = 0; j < n_src; ++j) {
         const veil_cache_block* o = &src[j].b;

@@ -83,12 +83,13 @@ typedef struct veil_cache_report {
     double energy_groups[VEIL_CACHE_ENERGY_GROUPS][VEIL_CACHE_ENERGY_KINDS][3];
 } veil_cache_report;
 
-/* Programs of the cache's passes (dense, and sparse made when first needed). */
+/* Programs of the cache's passes (dense, and sparse made when first needed; the photons' also with a frame's
+ * solid, trace[2 + sparse]: scene/solid.h). */
 typedef struct veil_cache_programs {
-    GLuint bounds[2], trace[2], resolve, ubo;
+    GLuint bounds[2], trace[4], resolve, ubo;
 } veil_cache_programs;
 
-veil_result veil__cache_programs(veil_cache_programs* p, int sparse, veil_error* err);
+veil_result veil__cache_programs(veil_cache_programs* p, int sparse, int solid, veil_error* err);
 void veil__cache_programs_free(veil_cache_programs* p);
 
 /* At most this many cells (56 bytes each while built, 32 kept: 235 MB and

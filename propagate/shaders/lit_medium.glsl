@@ -85,8 +85,11 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
 #endif
 }
 
+#ifdef VEIL_SOLID
 // The surfaces of a frame under `veil fog` (scene/solid.h): solid voxels,
-// and per light the distance along its path to the first of them.
+// and per light the distance along its path to the first of them. A
+// variant: without a solid the shaders are compiled without it (llvmpipe
+// runs the texture reads of a branch not taken).
 layout(binding = VEIL_TEX_SOLID) uniform sampler3D u_solid;
 layout(binding = VEIL_TEX_SHADOW) uniform sampler2DArray u_shadow;
 
@@ -145,6 +148,7 @@ float solid_hit(vec3 p, vec3 d, float t_max)
     }
     return t_max;
 }
+#endif
 
 // Light l at x before the medium: the direction it travels, its irradiance
 // E (W/m^2: I / r^2 for point and spot lights, with the cone; a sun's own;
@@ -166,7 +170,9 @@ bool light_at(int l, vec3 x, out vec3 travel, out vec3 E, out float len)
         E = med.lights[l].color.rgb;
         len = INF;
     }
-    if (med.solid_origin.w > 0.0) E *= solid_visibility(l, x);
+#ifdef VEIL_SOLID
+    E *= solid_visibility(l, x);
+#endif
     return max(E.r, max(E.g, E.b)) > 0.0;
 }
 

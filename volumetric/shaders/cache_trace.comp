@@ -212,6 +212,7 @@ void trace(uint n)
         uint k = uint(c.x) + uint(cb.dims.x) * (uint(c.y) + uint(cb.dims.y) * uint(c.z));
         float maj = cells[k].x * cb.scale.w;
         if (maj > 0.0) maj = max(maj, cb.sigma_a.w);
+#ifdef VEIL_SOLID
         // a frame's surface (veil fog, scene/solid.h) before the next collision or the cell's side absorbs it
         float t_next = maj * t_exit <= tau ? t_exit : tau / maj;
         float t_solid = solid_hit(pos, dir, t_next);
@@ -222,6 +223,7 @@ void trace(uint n)
             }
             break;
         }
+#endif
         if (maj * t_exit <= tau) { // no collision in the cell: on to the next
             if (scored) visit(c, w, dir, t_exit, odd);
             flush(c, odd);
