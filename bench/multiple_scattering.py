@@ -11,6 +11,14 @@ all-orders path tracer (`veil reference --max-order 0`).
 --converge: the cache's error against its budget (photons doubling, then
 cells), into docs/results/cache_convergence.{md,dat,png}.
 
+    python3 bench/multiple_scattering.py --times [--rungs default,max] [--runs R] [--scenes a,b,...]
+
+--times: no reference, no error; each scene's still frame at its own
+camera's size (the size a user renders it at; the error table is at
+--size), single scattering and the light cache at each of --rungs, run in
+turn R times (default 3): medians of the stages' sum and the
+median of the pairs' ratios, into docs/results/still_times.md.
+
 For each scene (at two optical thicknesses: the file's sigma_a, sigma_s and
 those times --thick) it renders every variant with `veil render --stats`
 (time: the median over --runs of the sum of the stages' wall times, i.e. a
@@ -261,6 +269,44 @@ def converge(a, names, w, h, spp, ref_veil, cache, tmp):
     print("wrote %s.md" % base, file=sys.stderr)
 
 
+def own_size_times(a, tmp):
+    """Still frames at each scene's own size: the cache against single scattering at the same rung."""
+    wanted = [s for s in a.scenes.split(",") if s]
+    lines = ["| scene | size | rung | single scattering (ms) | light cache (ms) | ratio (range of pairs) |",
+             "|---|---|---|---:|---:|---:|"]
+    for name, base, folder, fit, thick in scenes():
+        if wanted and name not in wanted:
+            continue
+        scene = absolutise(base, folder)
+        size = "%dx%d" % (scene["camera"]["width"], scene["camera"]["height"])
+        for rung in a.rungs.split(","):
+            ms_of = {}
+            for vname, ms in (("ss", {"screen_space": False, "volumetric": False}), ("cache", CACHE)):
+                sp = os.path.join(tmp, vname + ".json")
+                with open(sp, "w") as f:
+                    json.dump(with_ms(scene, ms), f)
+                ms_of[vname] = sp
+            pairs = {"ss": [], "cache": []}
+            for r in range(a.runs):
+                for vname in ("ss", "cache"):
+                    st = stage_ms(run([a.veil, "render", ms_of[vname], "-o", os.path.join(tmp, "t.exr"), "--quality",
+                                       rung, "--stats", "--seed", str(r + 1)]))
+                    pairs[vname].append(sum(st.values()))
+            ratios = [c / s_ for s_, c in zip(pairs["ss"], pairs["cache"])]
+            line = "| %s | %s | %s | %.0f | %.0f | %.2f (%.2f-%.2f) |" % (
+                name, size, rung, statistics.median(pairs["ss"]), statistics.median(pairs["cache"]),
+                statistics.median(ratios), min(ratios), max(ratios))
+            lines.append(line)
+            print(line, flush=True)
+    path = os.path.join(a.out, "still_times.md")
+    with open(path, "w") as f:
+        f.write("Still frames at each scene's own size: `python3 bench/multiple_scattering.py --times --rungs %s "
+                "--runs %d` (the stages' sum, medians of %d runs in turn; the ratio: the median of the pairs').\n\n"
+                % (a.rungs, a.runs, a.runs))
+        f.write("\n".join(lines) + "\n")
+    print("wrote %s" % path, file=sys.stderr)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
@@ -271,6 +317,8 @@ def main():
     ap.add_argument("--scenes", default="")
     ap.add_argument("--study", action="store_true")
     ap.add_argument("--candidates", action="store_true", help="also the earlier candidates (screen, legs, diffusion)")
+    ap.add_argument("--times", action="store_true", help="still frames at each scene's own size, no references")
+    ap.add_argument("--rungs", default="default,max", help="--times: the quality rungs")
     ap.add_argument("--converge", default="", help="scenes (semicolon-separated: names hold commas): the cache's error against its budget")
     ap.add_argument("--veil", default=os.path.join(ROOT, "build", "veil"))
     ap.add_argument("--ref-veil", default="", help="the veil that renders the references (default: --veil)")
@@ -288,6 +336,8 @@ def main():
     variants = VARIANTS + (CANDIDATES if a.candidates else []) + (STUDY if a.study else [])
     if a.converge:
         return converge(a, [s for s in a.converge.split(";") if s], w, h, spp, ref_veil, cache, tmp)
+    if a.times:
+        return own_size_times(a, tmp)
     for name, base, folder, fit, thick in scenes():
         if wanted and name not in wanted:
             continue

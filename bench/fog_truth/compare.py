@@ -43,15 +43,17 @@ import scenes  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-# name, lights, multiple_scattering: the variants; each removes one part
+# name, lights, multiple_scattering, extra arguments: the variants; each removes one part
 VARIANTS = [
-    ("attenuation", False, {"screen_space": False}),
-    ("atten+spread", False, None),
-    ("ss", True, {"screen_space": False, "volumetric": False}),
-    ("ss+volumetric", True, {"screen_space": False}),  # the default volumetric estimate (the light cache)
-    ("ss+octaves", True, {"screen_space": False, "volumetric_method": "octave"}),
-    ("ss+spread", True, {"volumetric": False}),
-    ("default", True, None),
+    ("attenuation", False, {"screen_space": False}, []),
+    ("atten+spread", False, None, []),
+    ("ss", True, {"screen_space": False, "volumetric": False}, []),
+    ("ss+volumetric", True, {"screen_space": False}, []),  # the default volumetric estimate (the light cache)
+    ("ss+octaves", True, {"screen_space": False, "volumetric_method": "octave"}, []),
+    ("ss+spread", True, {"volumetric": False}, []),
+    ("default", True, None, []),
+    # the frame's surfaces neither shadow the medium nor absorb its light (scene/solid.h)
+    ("no occluders", True, None, ["--no-occluders"]),
 ]
 
 
@@ -116,12 +118,13 @@ def stats_ms(text):
     return ms
 
 
-def run_veil(veil, frame, scene, out, folder, name):
+def run_veil(veil, frame, scene, out, folder, name, extra):
     path = os.path.join(folder, name + ".json")
     with open(path, "w") as f:
         json.dump(scene, f, indent=1)
     t0 = time.time()
-    p = subprocess.run([veil, "fog", frame, "--scene", path, "-o", out, "--stats"], capture_output=True, text=True)
+    p = subprocess.run([veil, "fog", frame, "--scene", path, "-o", out, "--stats"] + extra, capture_output=True,
+                       text=True)
     wall = time.time() - t0
     if p.returncode != 0:
         sys.exit("compare.py: veil fog failed on %s:\n%s%s" % (path, p.stdout, p.stderr))
@@ -173,10 +176,11 @@ def main():
         print("   %-14s %9s %14s %14s %10s" % ("variant", "bias", "relRMSE 4x4", "per pixel", "time (ms)"))
         imgs = {}
         res = {}
-        for name, lights, ms in VARIANTS:
-            out = os.path.join(d, "%s_veil_%s.exr" % (case, name))
+        for name, lights, ms, extra in VARIANTS:
+            tag = name.replace(" ", "_")
+            out = os.path.join(d, "%s_veil_%s.exr" % (case, tag))
             sc = scenes.veil_scene(case, lights=lights, multiple=ms)
-            t_ms, wall = run_veil(args.veil, frame_path, sc, out, d, "%s_%s" % (case, name))
+            t_ms, wall = run_veil(args.veil, frame_path, sc, out, d, "%s_%s" % (case, tag), extra)
             img = rgb_of(out)
             imgs[name] = img
             bias = float(img.mean()) / m_truth - 1.0
