@@ -365,9 +365,8 @@ VEIL_STRUCT_END(veil_diffusion_block)
 #define VEIL_BIND_CACHE_EMIT 2     /* the emitting cells: uvec2 (cell, the CDF up to it as float bits) */
 #define VEIL_BIND_CACHE_COUNT 3    /* uint[4]: photons cut at the step cap, scores clamped, majorant misses, -;
                                       then the energy account's int64 sums (below) */
-#define VEIL_BIND_CACHE_FREE 4     /* float[cells]: the part of each cell not inside a frame's solid (scene/solid.h);
-                                      the resolve divides by it, at least VEIL_CACHE_MIN_FREE */
-#define VEIL_CACHE_MIN_FREE 0.125
+#define VEIL_BIND_CACHE_FREE 4     /* float[cells]: the part of each cell not inside a frame's solid (scene/solid.h),
+                                      kept as the flux's alpha: the march divides by it, interpolated */
 /* The energy account of the light that scattered (or was emitted): per
  * group of photons (photon n in group n mod VEIL_CACHE_ENERGY_GROUPS, for a
  * standard error), per channel, the weight that entered (at its first

@@ -162,13 +162,17 @@ vec3 cache_in(vec3 x, vec3 dir, float f)
     if (!(all(greaterThanEqual(c, vec3(0.0))) && all(lessThanEqual(c, vec3(1.0))))) return vec3(0.0);
     float nz = u.diffusion_inv.w, z = clamp(c.z * nz, 0.5, nz - 0.5);
     vec3 phi = texture(u_phi, vec3(c.xy, z / (4.0 * nz))).rgb;
-    vec3 F = texture(u_phi, vec3(c.xy, (z + nz) / (4.0 * nz))).xyz;
+    vec4 Fa = texture(u_phi, vec3(c.xy, (z + nz) / (4.0 * nz)));
+    vec3 F = Fa.xyz;
+    // the cells hold their sums and (alpha) their part outside a frame's solid (1 without one): the
+    // fluence of the fog here is the two interpolated, divided (a lobe's shape is a ratio: unchanged)
+    if (!(Fa.w > 0.0)) return vec3(0.0);
     vec3 phi2 = texture(u_phi, vec3(c.xy, (z + 2.0 * nz) / (4.0 * nz))).rgb;
     vec3 F2 = texture(u_phi, vec3(c.xy, (z + 3.0 * nz) / (4.0 * nz))).xyz;
     float g = med.shape.z;
     vec3 phi1 = max(phi - phi2, vec3(0.0)); // the texture holds all the light and the later light
     phi2 = max(phi2, vec3(0.0));
-    return phi1 * cache_lobe(phi1, F - F2, dir, g) + phi2 * (cache_lobe(phi2, F2, dir, g) - f * cache_lobe(phi2, F2, dir, 1.0));
+    return (phi1 * cache_lobe(phi1, F - F2, dir, g) + phi2 * (cache_lobe(phi2, F2, dir, g) - f * cache_lobe(phi2, F2, dir, 1.0))) / Fa.w;
 }
 
 // Distance to the nearest point or spot light (INF without one).

@@ -58,9 +58,9 @@
  *    spread, as in 4). Without the floor it would be 0 (albedo 1). What
  *    scattered is E A (1 - exp(-sigma_s (1 - y))) for y between those
  *    heights, and what scattered = what left + what was absorbed. The cells
- *    in the floor hold no track: the fluence of each cell times the volume
- *    of its part outside the solid (at least VEIL_CACHE_MIN_FREE of it,
- *    4^3 points a cell) sums to the track length, as in 4. */
+ *    keep their sums, whose volume integral is the track length as in 4,
+ *    and beside them (the flux's alpha) their part outside the solid, 4^3
+ *    points a cell, which the march divides by. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -419,6 +419,7 @@ static void floor_absorbs(veil_volumetric* d)
     /* each cell's part outside the solid */
     const double h = 2.0 / 12.0, V = h * h * h;
     double free_part[12 * 12 * 12];
+    float* flux = veil_volumetric_readback_flux(d, dims);
     for (int k = 0; k < 12 * 12 * 12; ++k) {
         int cc[3] = {k % 12, k / 12 % 12, k / 144}, in = 0;
         for (int q = 0; q < 64; ++q) {
@@ -426,8 +427,16 @@ static void floor_absorbs(veil_volumetric* d)
             for (int a = 0; a < 3; ++a) x[a] = -1.0f + ((float)cc[a] + (((q >> (2 * a)) & 3) + 0.5f) / 4.0f) * (float)h;
             in += veil_solid_at(&so, x);
         }
-        free_part[k] = fmax(1.0 - in / 64.0, VEIL_CACHE_MIN_FREE);
+        free_part[k] = 1.0 - in / 64.0;
     }
+    int wrong = 0, partial = 0;
+    for (int k = 0; flux && k < 12 * 12 * 12; ++k) {
+        wrong += flux[4 * k + 3] != (float)free_part[k];
+        partial += free_part[k] > 0.0 && free_part[k] < 1.0;
+    }
+    CHECK(flux && wrong == 0 && partial >= 144, "floor: %d cells' free part (the flux's alpha) is not the solid's "
+          "(%d cells part solid)", wrong, partial);
+    free(flux);
     for (int ch = 0; ch < 3; ++ch) {
         double se_g, se_lo, se_hi;
         const int k_in[1] = {VEIL_CACHE_ENERGY_IN}, k_ab[1] = {VEIL_CACHE_ENERGY_ABSORBED};
@@ -449,12 +458,12 @@ static void floor_absorbs(veil_volumetric* d)
         CHECK(frac >= lo && frac <= hi, "floor, channel %d: the floor absorbs %.5f of what scattered; the CPU walk "
               "%.5f .. %.5f (allowed %.5f .. %.5f)", ch, frac, f_lo, f_hi, lo, hi);
         double cells = 0.0, track = c->energy[VEIL_CACHE_ENERGY_TRACK][ch];
-        for (int k = 0; k < 12 * 12 * 12; ++k) cells += phi[4 * k + ch] * V * free_part[k];
+        for (int k = 0; k < 12 * 12 * 12; ++k) cells += phi[4 * k + ch] * V;
         double tol_t = track_tolerance(c, 4.0, h, track);
-        CHECK(fabs(cells - track) <= tol_t, "floor, channel %d: the cells' fluence times their free volume %.9g W m, "
+        CHECK(fabs(cells - track) <= tol_t, "floor, channel %d: the cells' sums times their volume %.9g W m, "
               "the track %.9g: off by %.3g > %.3g", ch, cells, track, cells - track, tol_t);
         printf("floor, channel %d: scattered %.5g W (closed form %.5g .. %.5g), the floor absorbs %.4f of it (CPU "
-               "walk %.4f .. %.4f, se %.4f / %.4f); cells x free volume %.7g, track %.7g\n", ch, in, want_lo, want_hi,
+               "walk %.4f .. %.4f, se %.4f / %.4f); cells x volume %.7g, track %.7g\n", ch, in, want_lo, want_hi,
                frac, f_lo, f_hi, se_frac, se_lo, cells, track);
     }
     free(phi);

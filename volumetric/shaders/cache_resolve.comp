@@ -4,16 +4,20 @@
 // the odd photons' luminance fluence beside it (for the noise estimate), and
 // nz cells above it the luminance-weighted flux (W/m^2), of all the light;
 // above those the same two of the light scattered more than once (for the
-// emission: scattered at all).
+// emission: scattered at all). The flux's alpha: the cell's part outside a
+// frame's solid (below).
 layout(local_size_x = VEIL_CACHE_CELL_GROUP, local_size_y = VEIL_CACHE_CELL_GROUP, local_size_z = VEIL_CACHE_CELL_GROUP) in;
 layout(std140, binding = VEIL_UBO_CACHE) uniform veil_cache_ubo { veil_cache_block cb; };
 layout(std430, binding = VEIL_BIND_CACHE_SUM) readonly buffer veil_cache_sums { uint sums[]; };
 layout(binding = VEIL_IMAGE_CACHE, rgba32f) writeonly uniform image3D u_cache; // fluence below, flux above
 // Under veil fog a frame's surfaces are solid (scene/solid.h): the photons'
-// track lies in the part of a cell outside them, so that part's volume is
-// what the track is divided by (the sums are per cell volume: divided by its
-// free part here). Cells less free than VEIL_CACHE_MIN_FREE are divided by
-// that (a sliver of fog in a wall cell would otherwise amplify its noise).
+// track lies in the part of a cell outside them, so the fluence there is
+// the sums (per cell volume) divided by that part. The fields are kept as
+// the sums, with the free part beside the flux (its alpha): the march
+// interpolates both and divides, so that a cell mostly in a wall weighs as
+// little as its fog (interpolating fluences would pull the fog by a wall
+// towards the wall's empty cells; dividing each cell first would amplify a
+// sliver's noise). 1 everywhere without a solid.
 layout(std430, binding = VEIL_BIND_CACHE_FREE) readonly buffer veil_cache_free { float free_part[]; };
 
 // the signed 64-bit sum at word k, in W/m^2: the high word and the low
@@ -34,10 +38,8 @@ void main()
     uint l = k + uint(VEIL_CACHE_LATER);
     vec3 phi1 = vec3(sum_at(k), sum_at(k + 2u), sum_at(k + 4u)), flux1 = vec3(sum_at(k + 6u), sum_at(k + 8u), sum_at(k + 10u));
     vec3 phi2 = vec3(sum_at(l), sum_at(l + 2u), sum_at(l + 4u)), flux2 = vec3(sum_at(l + 6u), sum_at(l + 8u), sum_at(l + 10u));
-    float inv = 1.0 / max(free_part[k / uint(VEIL_CACHE_WORDS)], float(VEIL_CACHE_MIN_FREE));
-    phi1 *= inv, flux1 *= inv, phi2 *= inv, flux2 *= inv;
-    imageStore(u_cache, c, vec4(phi1 + phi2, sum_at(k + 12u) * inv));
-    imageStore(u_cache, c + ivec3(0, 0, cb.dims.z), vec4(flux1 + flux2, 0.0));
+    imageStore(u_cache, c, vec4(phi1 + phi2, sum_at(k + 12u)));
+    imageStore(u_cache, c + ivec3(0, 0, cb.dims.z), vec4(flux1 + flux2, free_part[k / uint(VEIL_CACHE_WORDS)]));
     imageStore(u_cache, c + ivec3(0, 0, 2 * cb.dims.z), vec4(phi2, 0.0));
     imageStore(u_cache, c + ivec3(0, 0, 3 * cb.dims.z), vec4(flux2, 0.0));
 }
