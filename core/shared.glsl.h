@@ -179,7 +179,8 @@ VEIL_STRUCT_BEGIN(veil_march_block)
     VEIL_V4(cam_right);    /* xyz: right, scaled by tan(fov/2) and the aspect */
     VEIL_V4(cam_up);       /* xyz: up, scaled by tan(fov/2) */
     VEIL_V4(background);   /* rgb: radiance behind the medium */
-    VEIL_V4(march);        /* x: step (m); yzw: - */
+    VEIL_V4(march);        /* x: step (m); the cache's gather (render/shaders/cache_gather.comp): y its rays a cell (0: off),
+                              z its steps in the cache's cells, w the cache's cells a side of one of its cells */
     VEIL_V4(limits);       /* x: no step starts at or beyond this distance (m; 3e38: no limit) */
     VEIL_IV4(size);        /* x, y: image size (pixels); z: the first row of this dispatch's band */
     VEIL_UV4(flags);       /* x: -, y: skip empty bricks, z: jitter seed, w: per-pixel end */
@@ -394,7 +395,15 @@ VEIL_STRUCT_END(veil_diffusion_block)
  * [3 nz, 4 nz). One sampler reads them all (the march clamps z within a quarter, so filtering never crosses): on Mesa 22's
  * llvmpipe a second 3D sampler read with texture() in the march returned 0 on all but the first
  * invocation of each row of a work group (texelFetch did not). */
-#define VEIL_IMAGE_CACHE 0         /* image unit: the cache, written by the resolve pass */
+#define VEIL_IMAGE_CACHE 0         /* image unit: the cache, written by the resolve pass (and its slab 4 by the gather) */
+/* The slabs of the cache's texture: the four above, and a fifth the camera's (render/shaders/cache_gather.comp):
+ * the later light scattered towards the camera, gathered along rays through the medium from the cells' lobes,
+ * rewritten for each camera; the volumetric stage leaves it 0. */
+#define VEIL_CACHE_SLABS 5
+#define VEIL_GATHER_GROUP 4        /* 4^3 cells a work group of the gather */
+#define VEIL_GATHER_MAX_OPT 0.5    /* the gather's steps split above this optical thickness (reduced extinction) */
+#define VEIL_GATHER_MAX_LOBE 0.9   /* the gather's second technique: the light's lobe at most this peaked */
+#define VEIL_GATHER_MAX_CELLS 64   /* the gather's cells along the grid's longest side, at most (coarser: s^3 cache cells) */
 /* The photons' work (steps: a piece of path in a cell, or a tentative
  * collision). volumetric/cache.c estimates the steps a photon takes from
  * the cells' majorants; the photons of a cache take at most

@@ -20,10 +20,10 @@
  * each rung slower and more accurate than the one below it on the shared
  * smoke, none dominated on the three scenes of bench/peers.py. */
 static const veil_quality_rung rungs[VEIL_QUALITY_COUNT] = {
-    [VEIL_QUALITY_DRAFT] = {1.0f, VEIL_OPV_LIGHT_SPACE, 1.0f, 4.0f, 1LL << 16, 24},
-    [VEIL_QUALITY_DEFAULT] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.5f, 4.0f, 1LL << 18, 40},
-    [VEIL_QUALITY_HIGH] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.35f, 4.0f, 1LL << 20, 64},
-    [VEIL_QUALITY_MAX] = {0.25f, VEIL_OPV_LIGHT_SPACE, 0.25f, 4.0f, 1LL << 22, 96},
+    [VEIL_QUALITY_DRAFT] = {1.0f, VEIL_OPV_LIGHT_SPACE, 1.0f, 4.0f, 1LL << 16, 24, 0, 0.0f},
+    [VEIL_QUALITY_DEFAULT] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.5f, 4.0f, 1LL << 18, 40, 16, 2.0f},
+    [VEIL_QUALITY_HIGH] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.35f, 4.0f, 1LL << 20, 64, 16, 2.0f},
+    [VEIL_QUALITY_MAX] = {0.25f, VEIL_OPV_LIGHT_SPACE, 0.25f, 4.0f, 1LL << 22, 96, 64, 2.0f},
 };
 
 const veil_quality_rung* veil_quality_rung_of(veil_quality q)

@@ -512,6 +512,14 @@ static veil_result render_build(veil_frame* f, veil_stage_report* rep, veil_erro
                           .max_distance = o->max_distance, .end_distance = o->behind_distance,
                           .no_background = o->behind != NULL, .field = &f->field};
     md.medium.opv = opv;
+    /* the cache's later light gathered towards the camera: as the scene says, else the rung's where the
+     * phase function's forward peak holds at least half its scattering (render/march.h) */
+    const veil_quality_rung* q = veil_quality_rung_of(o->quality);
+    const int gather = p->scene->multiple.cache_gather_rays;
+    const veil_phase* ph = &p->scene->medium.phase;
+    const int peaked = ph->type == VEIL_PHASE_HG && ph->g >= VEIL_GATHER_MIN_G;
+    md.gather_rays = gather < 0 ? 0 : gather > 0 ? gather : peaked ? q->gather_rays : 0;
+    md.gather_step = q->gather_step > 0.0f ? q->gather_step : 1.0f;
     if (f->solid.voxels) { /* what the lights and the cache saw of the frame's surfaces */
         size_t len = strlen(rep->why);
         snprintf(rep->why + len, sizeof rep->why - len, "; the frame's surfaces as a solid (scene/solid.h): "
@@ -520,6 +528,13 @@ static veil_result render_build(veil_frame* f, veil_stage_report* rep, veil_erro
                  f->solid.maps == 1 ? "" : "s", f->solid_ms);
     }
     veil_result res = veil_march_run(f->parts->march, &md, f->images, err);
+    const veil_march_gather g = veil_march_last_gather(f->parts->march);
+    if (res == VEIL_OK && g.rays > 0) {
+        size_t len = strlen(rep->why);
+        snprintf(rep->why + len, sizeof rep->why - len, "; the cache's later light gathered towards the camera "
+                 "(render/march.h): %d rays a cell, %dx%dx%d cells, steps of %.3g cells, %.0f ms", g.rays, g.dims[0],
+                 g.dims[1], g.dims[2], (double)g.step, g.ms);
+    }
     if (res == VEIL_OK && o->behind) { /* what is behind, attenuated: T L */
         veil_image_set* im = f->images;
         size_t pixels = (size_t)im->width * (size_t)im->height;

@@ -81,6 +81,8 @@ typedef struct veil_quality_rung {
     float sun_across, sun_along;
     long long cache_photons; /* the light cache's budget (volumetric/cache.h) */
     int cache_cells;
+    int gather_rays;         /* the cache's later light gathered towards the camera: rays a cell (0: off) */
+    float gather_step;       /* and its rays' steps, in the cache's cells (render/march.h) */
 } veil_quality_rung;
 const veil_quality_rung* veil_quality_rung_of(veil_quality q); /* UNSET: the default rung */
 

@@ -12,7 +12,7 @@ static const char* const MS_KEYS[] = {
     "filter", "weights", "interpolation", "separation", "separation_luminance", "separation_luminance_width",
     "separation_density", "separation_density_width", "k_ssc", "thin_threshold", "octaves", "emission_lights", "octave_extinction",
     "octave_contribution", "octave_eccentricity", "volumetric_method", "diffusion_cells", "diffusion_iterations",
-    "octave_gate", "cache_photons", "cache_cells", "cache_seed", NULL};
+    "octave_gate", "cache_photons", "cache_cells", "cache_seed", "cache_gather_rays", NULL};
 static const char* const GATES[] = {"legs", "escape", NULL}; /* = veil_octave_gate */
 static const char* const VOL_METHODS[] = {"octave", "diffusion", "cache", NULL}; /* = veil_volumetric_method */
 static const char* const FILTERS[] = {"2x2", "4x4", "6x6", NULL};                                 /* = veil_spread_filter */
@@ -31,6 +31,7 @@ static const range R_CELLS = {8, 256, false, false, true, "an integer in [8, 256
 static const range R_PHOTONS = {0, 1 << 30, false, false, true, "an integer in [0, 1073741824] (0: the quality's)"};
 static const range R_CACHE_CELLS = {0, 512, false, false, true, "an integer in [0, 512] (0: the quality's; else at least 4)"};
 static const range R_SEED = {0, 2147483647.0, false, false, true, "an integer in [0, 2147483647]"};
+static const range R_GATHER = {-1, 4096, false, false, true, "an integer in [-1, 4096] (0: the quality's; -1: off)"};
 static const range R_ITER = {0, 100000, false, false, true, "an integer in [0, 100000] (0: 3 x the cells)"};
 
 static veil_result get_bool(const ctx* c, const cJSON* o, const jpath* pp, const char* key, int* out)
@@ -95,6 +96,7 @@ veil_result veil__parse_multiple(const ctx* c, const cJSON* root, veil_multiple*
         return veil__jr_fail_at(c, &cp, "expected 0 (the quality's) or an integer in [4, 512], got %d", m->cache_cells);
     }
     TRY(veil__jr_get_int(c, o, &p, "cache_seed", &R_SEED, &seed));
+    TRY(veil__jr_get_int(c, o, &p, "cache_gather_rays", &R_GATHER, &m->cache_gather_rays));
     m->cache_photons = photons, m->cache_seed = (unsigned)seed;
     TRY(get_float(c, o, &p, "c", &R_POS, &m->c));
     TRY(get_float(c, o, &p, "mask_epsilon", &R_NONNEG, &m->mask_epsilon));

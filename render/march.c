@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/clock.h"
 #include "../core/progress.h"
 #include "../gpu/gl_util.h"
 #include "../gpu/programs.h"
@@ -17,7 +18,20 @@ enum { MARCH_SPARSE = 4, MARCH_EMISSION = 2, MARCH_SOLID = 1, MARCH_VARIANTS = 8
 
 struct veil_march {
     GLuint program[MARCH_VARIANTS], ubo, medium_ubo;
+    GLuint gather[4]; /* render/shaders/cache_gather.comp, at 2 sparse + solid; made when first needed */
+    veil_march_gather last_gather;
 };
+
+veil_march_gather veil_march_last_gather(const veil_march* m) { return m->last_gather; }
+
+static veil_result gather_variant(veil_march* m, int v, veil_error* err)
+{
+    if (m->gather[v]) return VEIL_OK;
+    static const char* const defines[4] = {"", "#define VEIL_SOLID 1\n", "#define VEIL_SPARSE 1\n",
+                                           "#define VEIL_SPARSE 1\n#define VEIL_SOLID 1\n"};
+    static const char* const names[4] = {"dense", "solid", "sparse", "sparse, solid"};
+    return veil_gpu_program_variant("render/shaders/cache_gather.comp", defines[v], names[v], &m->gather[v], err);
+}
 
 static veil_result variant(veil_march* m, int v, veil_error* err)
 {
@@ -54,6 +68,7 @@ void veil_march_destroy(veil_march* m)
 {
     if (!m) return;
     for (int v = 0; v < MARCH_VARIANTS; ++v) glDeleteProgram(m->program[v]);
+    for (int v = 0; v < 4; ++v) glDeleteProgram(m->gather[v]);
     glDeleteBuffers(1, &m->ubo);
     glDeleteBuffers(1, &m->medium_ubo);
     free(m);
@@ -91,6 +106,16 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
     if (d->field && d->field->texture) {
         set3(u->diffusion, d->field->tex_min, (float)d->field->kind);
         set3(u->diffusion_inv, d->field->tex_inv, (float)d->field->depth);
+        if (d->field->kind == VEIL_FIELD_CACHE && d->gather_rays > 0 && d->field->depth > 0) {
+            /* the gather's grid: at most VEIL_GATHER_MAX_CELLS a side, s^3 of the cache's cells a cell */
+            GLint n[3] = {0, 0, d->field->depth};
+            glGetTextureLevelParameteriv(d->field->texture, 0, GL_TEXTURE_WIDTH, &n[0]);
+            glGetTextureLevelParameteriv(d->field->texture, 0, GL_TEXTURE_HEIGHT, &n[1]);
+            const int longest = n[0] > n[1] ? (n[0] > n[2] ? n[0] : n[2]) : (n[1] > n[2] ? n[1] : n[2]);
+            u->march[1] = (float)d->gather_rays;
+            u->march[2] = d->gather_step > 0.0f ? d->gather_step : 1.0f;
+            u->march[3] = (float)((longest + VEIL_GATHER_MAX_CELLS - 1) / VEIL_GATHER_MAX_CELLS);
+        }
     }
     /* the octaves: asked for, or in place of a light cache that could not be made (a fog box too wide for
      * its grid, a medium too thick for photons): gated by the legs then (no escape field) */
@@ -184,11 +209,35 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         glBindTextureUnit(VEIL_TEX_LIMIT, limit);
         glBindTextureUnit(VEIL_TEX_DIFFUSION, d->field ? d->field->texture : 0);
         glBindTextureUnit(VEIL_TEX_EMISSION, lm->grid ? lm->emission : 0);
+        memset(&m->last_gather, 0, sizeof m->last_gather);
+        if (u.march[1] > 0.0f) { /* the cache's later light gathered towards this camera (slab 4) */
+            const double t0 = veil_now_ms();
+            const int gv = (lm->grid && lm->sparse ? 2 : 0) + (mu.solid_origin[3] > 0.0f ? 1 : 0);
+            r = gather_variant(m, gv, err);
+            if (r == VEIL_OK) {
+                GLint nx = 0, ny = 0;
+                glGetTextureLevelParameteriv(d->field->texture, 0, GL_TEXTURE_WIDTH, &nx);
+                glGetTextureLevelParameteriv(d->field->texture, 0, GL_TEXTURE_HEIGHT, &ny);
+                glUseProgram(m->gather[gv]);
+                glBindImageTexture(VEIL_IMAGE_CACHE, d->field->texture, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+                const int sc = (int)u.march[3];
+                const int gd[3] = {(nx + sc - 1) / sc, (ny + sc - 1) / sc, (d->field->depth + sc - 1) / sc};
+                glDispatchCompute(veil_groups(gd[0], VEIL_GATHER_GROUP), veil_groups(gd[1], VEIL_GATHER_GROUP),
+                                  veil_groups(gd[2], VEIL_GATHER_GROUP));
+                glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+                glFinish(); /* its time apart from the march's (--stats) */
+                veil_march_gather* g = &m->last_gather;
+                g->rays = (int)u.march[1], g->scale = sc, g->step = u.march[2], g->ms = veil_now_ms() - t0;
+                memcpy(g->dims, gd, sizeof gd);
+                glBindImageTexture(VEIL_IMAGE_CACHE, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+                glUseProgram(m->program[v]);
+            }
+        }
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], tex[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         const int band = veil_march_band_rows(d, w, h);
         const int report = veil_progress_wanted();
         if (report) veil_progress("march, rows", 0, h);
-        for (int y = 0; y < h; y += band) {
+        for (int y = 0; y < h && r == VEIL_OK; y += band) { /* (r: the gather's program was made) */
             if (y > 0) { /* the band's first row: size.z of the march's block (uploaded with 0) */
                 u.size[2] = y;
                 glNamedBufferSubData(m->ubo, offsetof(veil_march_block, size), sizeof u.size, u.size);
@@ -209,7 +258,7 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, 0);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MEDIUM, 0);
         glUseProgram(0);
-        r = veil_gl_check("ray march (render/shaders/march.comp)", err);
+        if (r == VEIL_OK) r = veil_gl_check("ray march (render/shaders/march.comp)", err);
         for (int i = 0; i < N && r == VEIL_OK; ++i)
             r = veil_gl_read_texture(tex[i], GL_RGBA, floats, *dst[i], "reading back the image", err);
     }

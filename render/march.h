@@ -37,6 +37,12 @@
 
 typedef struct veil_march veil_march;
 
+/* The phase function's g from which the default gathers the cache's later light (render/shaders/
+ * cache_gather.comp) instead of reading its lobe: where the delta-Eddington forward peak f = g^2 holds at
+ * least half of the scattering. The lobe's error grows with g and is 0 at g = 0, where the gather gives the
+ * lobe's answer at more cost (docs/multiple-scattering.md, "The gather": measured at g <= 0.6 and 0.85). */
+#define VEIL_GATHER_MIN_G 0.70710678f
+
 typedef struct veil_march_desc {
     veil_lit_medium medium;    /* the medium, the lights that add light and their optical depths */
     const veil_camera* camera;
@@ -49,7 +55,19 @@ typedef struct veil_march_desc {
                                   pixel's ray where it ends (a surface behind the medium) */
     int no_background;         /* 1: add no background (the caller composes what is behind) */
     const veil_volumetric_field* field; /* the volumetric stage's field; NULL or texture 0: none */
+    int gather_rays;           /* a light cache's later light gathered towards the camera, rays a cell
+                                  (render/shaders/cache_gather.comp; rounded to a square); 0: from its lobe.
+                                  By default (frame/) where HG g >= VEIL_GATHER_MIN_G */
+    float gather_step;         /* the gather's steps along its rays, in the cache's cells (> 0) */
 } veil_march_desc;
+
+/* What the last veil_march_run gathered (render/shaders/cache_gather.comp): rays 0 when it did not. */
+typedef struct veil_march_gather {
+    int rays, scale, dims[3]; /* rays a cell (a square), the cache's cells a side of one, its cells */
+    float step;               /* its rays' steps, in the cache's cells */
+    double ms;                /* its time, apart from the march's */
+} veil_march_gather;
+veil_march_gather veil_march_last_gather(const veil_march* m);
 
 veil_result veil_march_create(veil_march** out, veil_error* err);
 void veil_march_destroy(veil_march* m); /* accepts NULL */

@@ -97,6 +97,7 @@ void veil_multiple_defaults(veil_multiple* m)
     m->diffusion_iterations = 0;
     m->cache_photons = 0;
     m->cache_cells = 0;
+    m->cache_gather_rays = 0;
     m->cache_seed = 1;
     m->c = 0.86f;
     m->mask_epsilon = 2.0f;

@@ -168,6 +168,8 @@ typedef struct veil_multiple {
     long long cache_photons; /* photons in all; 0: the quality rung's */
     int cache_cells;         /* cells along the grid's longest side, 4..512; 0: the quality rung's */
     unsigned cache_seed;     /* the cache's random stream: the same seed gives the same cache */
+    int cache_gather_rays;   /* the later light gathered towards the camera (render/march.h), rays a cell;
+                                0: the quality rung's; -1: off (its lobe, as the draft rung) */
     /* screen-space */
     float c;              /* pixels: a level-k texel spreads by about c 2^(k-1) (paper: 0.86) */
     float mask_epsilon;   /* unitless: width of the leak mask, smoothstep(T, (1+eps) T, W) (paper: 2) */

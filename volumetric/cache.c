@@ -277,13 +277,13 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
         if (fr) r = veil_gl_buffer(fr, cells * sizeof *fr, 0, "veil cache free parts", &buf[4], err);
         free(fr);
     }
-    const int stacked[3] = {dims[0], dims[1], 4 * dims[2]};
+    const int stacked[3] = {dims[0], dims[1], VEIL_CACHE_SLABS * dims[2]};
     if (r == VEIL_OK) r = field_texture(stacked, "veil light cache (fluence, flux)", tex, err);
     if (r != VEIL_OK) goto done;
     static const uint32_t zero = 0;
     glClearNamedBufferData(buf[0], GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glClearNamedBufferData(buf[3], GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-    rep->bytes = (double)cells * (VEIL_CACHE_WORDS * 4.0 + 12.0 + 64.0); /* sums, cells, free parts, the texture */
+    rep->bytes = (double)cells * (VEIL_CACHE_WORDS * 4.0 + 12.0 + 16.0 * VEIL_CACHE_SLABS); /* sums, cells, free parts, the texture */
 
     /* 1. the cells' majorants (and emission weights) */
     r = veil_gl_buffer(mu, sizeof *mu, 0, "veil cache medium block", &medium_ubo, err);
@@ -469,12 +469,12 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
 
     /* 5. the noise: odd photons against even ones, E (o - e)^2 = Var(o + e) per cell */
     free(cellv);
-    cellv = malloc(cells * 16 * sizeof *cellv);
+    cellv = malloc(cells * 4 * VEIL_CACHE_SLABS * sizeof *cellv);
     if (!cellv) {
         r = veil_fail(err, VEIL_ERR_OOM, "out of memory reading the light cache back");
         goto done;
     }
-    r = veil_gl_read_texture(*tex, GL_RGBA, cells * 16, cellv, "the light cache", err);
+    r = veil_gl_read_texture(*tex, GL_RGBA, cells * 4 * VEIL_CACHE_SLABS, cellv, "the light cache", err);
     if (r != VEIL_OK) goto done;
     double dd = 0.0, tt = 0.0;
     for (size_t k = 0; k < cells; ++k) {

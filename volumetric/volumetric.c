@@ -342,16 +342,16 @@ veil_result veil_volumetric_update(veil_volumetric* d, const veil_volumetric_des
 }
 
 /* The kept field's texture read back: its first grid (layer 0) or, for the light cache's stacked
- * texture, another of its four (core/shared.glsl.h). */
+ * texture, another of its VEIL_CACHE_SLABS (core/shared.glsl.h). */
 static float* readback(const veil_volumetric* d, int layer, int dims[3])
 {
     if (!d->phi) return NULL;
     const int stacked = d->field.kind == VEIL_FIELD_CACHE;
     if (layer && !stacked) return NULL;
     size_t n = (size_t)d->dims[0] * (size_t)d->dims[1] * (size_t)d->dims[2] * 4;
-    float* out = malloc((stacked ? 4 : 1) * n * sizeof *out);
+    float* out = malloc((stacked ? VEIL_CACHE_SLABS : 1) * n * sizeof *out);
     if (!out) return NULL;
-    glGetTextureImage(d->phi, 0, GL_RGBA, GL_FLOAT, (GLsizei)((stacked ? 4 : 1) * n * sizeof *out), out);
+    glGetTextureImage(d->phi, 0, GL_RGBA, GL_FLOAT, (GLsizei)((stacked ? VEIL_CACHE_SLABS : 1) * n * sizeof *out), out);
     if (layer) memmove(out, out + (size_t)layer * n, n * sizeof *out);
     memcpy(dims, d->dims, 3 * sizeof *dims);
     return out; /* (a stacked texture's other layers stay allocated until it is freed) */

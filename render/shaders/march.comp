@@ -129,51 +129,7 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
     return sum;
 }
 
-// The light cache (volumetric/cache.h) towards -dir at x, per unit sigma_s
-// rho. It holds two lights, each a fluence phi and a flux F: the light
-// scattered once (of the emission: not yet scattered) and the later light
-// (scattered more often). Each is taken as one HG lobe about F with mean
-// cosine mu = |F| / phi, which the medium's HG(g) scatters into HG(g mu)
-// about F (HG convolved with HG is HG with the product of the g's). That is
-// how the once-scattered light is used. For the later light it is right
-// inside the medium and wrong at its skin, where the light going towards the
-// camera is what built up along the ray behind x (docs/multiple-scattering.md,
-// "What the error is"). So the phase function is split as delta-Eddington
-// splits it (Joseph et al. 1976): p = f delta + (1 - f) p' with f = g^2
-// (f_peak in main). The delta's share, f L(x, -dir), is the later light
-// arriving along the ray itself: main carries it by integrating with the
-// reduced extinction sigma_t - f sigma_s (light scattered into the delta
-// keeps its direction).
-// Here is the rest: the lobe's scattering less the lobe's own delta share,
-// phi (HG(g mu) - f HG(mu)) — exact where the lobe is the radiance, since
-// then the two delta terms cancel (a control variate), and negative where the
-// lobe is peaked towards the camera (the ray's share makes up for it).
-float cache_lobe(vec3 phi, vec3 F, vec3 dir, float g)
-{
-    float pl = dot(phi, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B)), fl = length(F);
-    float gc = pl > 0.0 && fl > 0.0 ? min(fl / pl, 1.0) : 0.0;
-    vec3 axis = fl > 0.0 ? F / fl : vec3(0.0, 0.0, 1.0);
-    return veil_phase_hg(dot(axis, -dir), g * gc);
-}
-
-vec3 cache_in(vec3 x, vec3 dir, float f)
-{
-    vec3 c = (x - u.diffusion.xyz) * u.diffusion_inv.xyz;
-    if (!(all(greaterThanEqual(c, vec3(0.0))) && all(lessThanEqual(c, vec3(1.0))))) return vec3(0.0);
-    float nz = u.diffusion_inv.w, z = clamp(c.z * nz, 0.5, nz - 0.5);
-    vec3 phi = texture(u_phi, vec3(c.xy, z / (4.0 * nz))).rgb;
-    vec4 Fa = texture(u_phi, vec3(c.xy, (z + nz) / (4.0 * nz)));
-    vec3 F = Fa.xyz;
-    // the cells hold their sums and (alpha) their part outside a frame's solid (1 without one): the
-    // fluence of the fog here is the two interpolated, divided (a lobe's shape is a ratio: unchanged)
-    if (!(Fa.w > 0.0)) return vec3(0.0);
-    vec3 phi2 = texture(u_phi, vec3(c.xy, (z + 2.0 * nz) / (4.0 * nz))).rgb;
-    vec3 F2 = texture(u_phi, vec3(c.xy, (z + 3.0 * nz) / (4.0 * nz))).xyz;
-    float g = med.shape.z;
-    vec3 phi1 = max(phi - phi2, vec3(0.0)); // the texture holds all the light and the later light
-    phi2 = max(phi2, vec3(0.0));
-    return (phi1 * cache_lobe(phi1, F - F2, dir, g) + phi2 * (cache_lobe(phi2, F2, dir, g) - f * cache_lobe(phi2, F2, dir, 1.0))) / Fa.w;
-}
+//@include render/shaders/cache_read.glsl
 
 // Distance to the nearest point or spot light (INF without one).
 float nearest_light(vec3 x)
@@ -196,7 +152,9 @@ void main()
     // cache, where T_red is T) and the transmittance of the reduced extinction sigma_t - f sigma_s that
     // carries the later light along the ray: the march goes on until it, not T, is negligible
     bool cache = u.diffusion.w == float(VEIL_FIELD_CACHE);
-    float f_peak = cache ? max(med.shape.z, 0.0) * max(med.shape.z, 0.0) : 0.0;
+    // (with the gather, u.march.y > 0, the later light towards the camera is gathered: no peak carried)
+    bool gather = cache && u.march.y > 0.0;
+    float f_peak = cache && !gather ? max(med.shape.z, 0.0) * max(med.shape.z, 0.0) : 0.0;
     vec3 T_red = vec3(1.0);
     float q_p = 0.0, q_w = 0.0;        // luminance-weighted P of Q
     float P = 0.0;                     // density integral along the ray (density m)
@@ -294,7 +252,7 @@ void main()
                 vec3 frac_red = vec3(veil_step_integral(opt_red.r), veil_step_integral(opt_red.g), veil_step_integral(opt_red.b));
                 precise vec3 j_red = med.sigma_s.rgb * (rho_dt * frac_red);
                 precise vec3 w_red = T_red * j_red;
-                Lv += w_red * cache_in(x, dir, f_peak);
+                Lv += w_red * cache_in(x, dir, f_peak, gather);
             }
             T_red *= exp(-opt_red);
             vec3 q = j * single * max(exp(-(med.sigma_t.rgb - med.sigma_s.rgb) * p_mid) - exp(-med.sigma_t.rgb * p_mid), 0.0);

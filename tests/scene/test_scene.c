@@ -175,7 +175,7 @@ static void test_multiple(void)
     r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'screen_space':false,'volumetric':true,"
               "'filter':'6x6','weights':[1,2,3,3,2,1],"
               "'interpolation':'cubic-bicubic','c':1.5,'levels':5,'octaves':4,'octave_gate':'legs',"
-              "'volumetric_method':'cache','cache_photons':4096,'cache_cells':12,'cache_seed':9,"
+              "'volumetric_method':'cache','cache_photons':4096,'cache_cells':12,'cache_seed':9,'cache_gather_rays':36,"
               "'separation':true,'separation_density':2,'separation_density_width':2}}", &s, &e);
     CHECK(r == VEIL_OK, "a full object: %s", e.msg);
     if (r == VEIL_OK) {
@@ -184,7 +184,7 @@ static void test_multiple(void)
               m->filter == VEIL_SPREAD_6X6 && m->interp == VEIL_INTERP_CUBIC_BICUBIC && m->c == 1.5f &&
               m->levels == 5 && m->octaves == 4 && m->octave_gate == VEIL_GATE_LEGS && m->separation &&
               m->volumetric_method == VEIL_VOLUMETRIC_CACHE && m->cache_photons == 4096 && m->cache_cells == 12 &&
-              m->cache_seed == 9 &&
+              m->cache_seed == 9 && m->cache_gather_rays == 36 &&
               m->sep_density == 2.0f && m->sep_density_width == 2.0f, "values read");
         double sum = 0.0;
         for (int i = 0; i < 6; ++i) sum += m->weights[i];
@@ -200,6 +200,12 @@ static void test_multiple(void)
     CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.cache_cells: expected 0 (the quality's) or an "
                                                  "integer in [4, 512], got 2"),
           "a cache of 2 cells refused: %s", e.msg);
+    r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'cache_gather_rays':-2}}", &s, &e);
+    CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.cache_gather_rays: expected an integer in [-1, 4096]"),
+          "a gather of -2 rays refused: %s", e.msg);
+    r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'cache_gather_rays':1.5}}", &s, &e);
+    CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.cache_gather_rays"),
+          "a gather of 1.5 rays refused: %s", e.msg);
     r = parse("ms.json", "{" CAM "," MED ",'multiple_scattering':{'cache_photons':-1}}", &s, &e);
     CHECK(r == VEIL_ERR_INVALID && strstr(e.msg, "multiple_scattering.cache_photons: expected an integer in [0, "),
           "negative photons refused: %s", e.msg);

@@ -19,6 +19,9 @@ layout(binding = VEIL_IMAGE_CACHE, rgba32f) writeonly uniform image3D u_cache; /
 // towards the wall's empty cells; dividing each cell first would amplify a
 // sliver's noise). 1 everywhere without a solid.
 layout(std430, binding = VEIL_BIND_CACHE_FREE) readonly buffer veil_cache_free { float free_part[]; };
+// The cells' majorant density (cache_bounds.comp), kept as the later fluence's alpha: the gather
+// (render/shaders/cache_gather.comp) skips the cells no density is near.
+layout(std430, binding = VEIL_BIND_CACHE_CELL) readonly buffer veil_cache_cells { vec2 cells[]; };
 
 // the signed 64-bit sum at word k, in W/m^2: the high word and the low
 // word's two halves joined in steps that are exact while |sum| < 2^40 units
@@ -40,6 +43,6 @@ void main()
     vec3 phi2 = vec3(sum_at(l), sum_at(l + 2u), sum_at(l + 4u)), flux2 = vec3(sum_at(l + 6u), sum_at(l + 8u), sum_at(l + 10u));
     imageStore(u_cache, c, vec4(phi1 + phi2, sum_at(k + 12u)));
     imageStore(u_cache, c + ivec3(0, 0, cb.dims.z), vec4(flux1 + flux2, free_part[k / uint(VEIL_CACHE_WORDS)]));
-    imageStore(u_cache, c + ivec3(0, 0, 2 * cb.dims.z), vec4(phi2, 0.0));
+    imageStore(u_cache, c + ivec3(0, 0, 2 * cb.dims.z), vec4(phi2, cells[k / uint(VEIL_CACHE_WORDS)].x));
     imageStore(u_cache, c + ivec3(0, 0, 3 * cb.dims.z), vec4(flux2, 0.0));
 }

@@ -25,24 +25,7 @@ layout(std430, binding = VEIL_BIND_CACHE_CELL) readonly buffer veil_cache_cells 
 layout(std430, binding = VEIL_BIND_CACHE_EMIT) readonly buffer veil_cache_emit { uvec4 emitters[]; };
 layout(std430, binding = VEIL_BIND_CACHE_COUNT) coherent buffer veil_cache_count { uint counts[]; };
 
-uint state;
-
-uint mix32(uint x)
-{
-    x ^= x >> 16; x *= 0x7feb352du;
-    x ^= x >> 15; x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-}
-
-// PCG (O'Neill 2014: an LCG step, a permuted output): 24 bits in [0, 1)
-float rnd()
-{
-    state = state * 747796405u + 2891336453u;
-    uint w = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    w = (w >> 22u) ^ w;
-    return float(w >> 8) * (1.0 / 16777216.0);
-}
+//@include volumetric/shaders/cache_random.glsl
 
 // A signed 64-bit add of v to the word pair at k (low word first): the low
 // word's atomic returns what it held, so its carry is known; the high word
@@ -131,24 +114,10 @@ void account(uint n)
     }
 }
 
-// A unit vector at cos_t from axis a, azimuth phi.
-vec3 around(vec3 a, float cos_t, float phi)
-{
-    vec3 t = abs(a.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
-    vec3 u = normalize(cross(a, t)), v = cross(a, u);
-    float sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));
-    return normalize(a * cos_t + (u * cos(phi) + v * sin(phi)) * sin_t);
-}
-
 // A direction scattered from d by Henyey-Greenstein g (inverting its CDF in cos).
 vec3 scatter_hg(vec3 d, float g)
 {
-    float xi = rnd(), cos_t;
-    if (abs(g) < 1e-3) cos_t = 1.0 - 2.0 * xi;
-    else {
-        float s = (1.0 - g * g) / (1.0 - g + 2.0 * g * xi);
-        cos_t = clamp((1.0 + g * g - s * s) / (2.0 * g), -1.0, 1.0);
-    }
+    float cos_t = hg_cos(g, rnd());
     return around(d, cos_t, 2.0 * VEIL_PI * rnd());
 }
 
