@@ -40,7 +40,9 @@ at REF_SPP_SCALE times --spp; the results in docs/ are at --spp 4096.
 
 References are cached in build/bench-cache/ms/, keyed by the scene text, the
 image size, spp and the bytes of the veil binary that renders them
-(--ref-veil, default --veil). Scenes in
+(--ref-veil, default --veil); --ref-map FILE names them instead (a JSON
+object, scene label: EXR path, relative to the repository), for references
+rendered by an earlier build of the ruler. Scenes in
 ../shared/data (third-party VDBs) are used when present, skipped otherwise.
 Results: docs/results/multiple_scattering.{csv,md} (and .png with gnuplot).
 Python 3 standard library only.
@@ -60,6 +62,10 @@ VARIANTS = [
     ("ss draft", {"screen_space": False, "volumetric": False}, "draft"),
     ("cache draft", CACHE, "draft"),
     ("cache default", CACHE, "default"),
+    # the later light read from its lobe, and gathered towards the camera, whatever g (the default gathers
+    # where HG g >= 1/sqrt(2): render/march.h)
+    ("cache default, lobe", dict(CACHE, cache_gather_rays=-1), "default"),
+    ("cache default, gathered", dict(CACHE, cache_gather_rays=16), "default"),
     ("ss high", {"screen_space": False, "volumetric": False}, "high"),
     ("cache high", CACHE, "high"),
     ("ss max", {"screen_space": False, "volumetric": False}, "max"),
@@ -270,10 +276,12 @@ def converge(a, names, w, h, spp, ref_veil, cache, tmp):
 
 
 def own_size_times(a, tmp):
-    """Still frames at each scene's own size: the cache against single scattering at the same rung."""
-    wanted = [s for s in a.scenes.split(",") if s]
-    lines = ["| scene | size | rung | single scattering (ms) | light cache (ms) | ratio (range of pairs) |",
-             "|---|---|---|---:|---:|---:|"]
+    """Still frames at each scene's own size: the cache against single scattering at the same rung; and the
+    turntable frame (render + spread: the stages a moving camera re-runs)."""
+    wanted = [s for s in a.scenes.split(";" if ";" in a.scenes else ",") if s]
+    lines = ["| scene | size | rung | single scattering (ms) | light cache (ms) | ratio (range of pairs) "
+             "| turntable frame: ss / cache (ms) | ratio (range) |",
+             "|---|---|---|---:|---:|---:|---:|---:|"]
     for name, base, folder, fit, thick in scenes():
         if wanted and name not in wanted:
             continue
@@ -287,21 +295,26 @@ def own_size_times(a, tmp):
                     json.dump(with_ms(scene, ms), f)
                 ms_of[vname] = sp
             pairs = {"ss": [], "cache": []}
+            turn = {"ss": [], "cache": []}
             for r in range(a.runs):
                 for vname in ("ss", "cache"):
                     st = stage_ms(run([a.veil, "render", ms_of[vname], "-o", os.path.join(tmp, "t.exr"), "--quality",
                                        rung, "--stats", "--seed", str(r + 1)]))
                     pairs[vname].append(sum(st.values()))
+                    turn[vname].append(st.get("render", 0.0) + st.get("spread", 0.0))
             ratios = [c / s_ for s_, c in zip(pairs["ss"], pairs["cache"])]
-            line = "| %s | %s | %s | %.0f | %.0f | %.2f (%.2f-%.2f) |" % (
+            tr = [c / s_ for s_, c in zip(turn["ss"], turn["cache"])]
+            line = "| %s | %s | %s | %.0f | %.0f | %.2f (%.2f-%.2f) | %.0f / %.0f | %.2f (%.2f-%.2f) |" % (
                 name, size, rung, statistics.median(pairs["ss"]), statistics.median(pairs["cache"]),
-                statistics.median(ratios), min(ratios), max(ratios))
+                statistics.median(ratios), min(ratios), max(ratios), statistics.median(turn["ss"]),
+                statistics.median(turn["cache"]), statistics.median(tr), min(tr), max(tr))
             lines.append(line)
             print(line, flush=True)
     path = os.path.join(a.out, "still_times.md")
     with open(path, "w") as f:
         f.write("Still frames at each scene's own size: `python3 bench/multiple_scattering.py --times --rungs %s "
-                "--runs %d` (the stages' sum, medians of %d runs in turn; the ratio: the median of the pairs').\n\n"
+                "--runs %d` (the stages' sum, medians of %d runs in turn; the ratio: the median of the pairs'). "
+                "The turntable frame: the render and spread stages alone (the cache is made once a turntable).\n\n"
                 % (a.rungs, a.runs, a.runs))
         f.write("\n".join(lines) + "\n")
     print("wrote %s" % path, file=sys.stderr)
@@ -322,11 +335,17 @@ def main():
     ap.add_argument("--converge", default="", help="scenes (semicolon-separated: names hold commas): the cache's error against its budget")
     ap.add_argument("--veil", default=os.path.join(ROOT, "build", "veil"))
     ap.add_argument("--ref-veil", default="", help="the veil that renders the references (default: --veil)")
+    ap.add_argument("--ref-map", default="", help="a JSON file naming each scene's reference EXR (label: path), "
+                    "used in place of rendering or the cache (references rendered by an earlier ruler)")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "results"))
     a = ap.parse_args()
     w, h = (int(v) for v in a.size.split("x"))
     spp = a.spp or (256 if a.quick else 1024)
     ref_veil = a.ref_veil or a.veil
+    ref_map = {}
+    if a.ref_map:
+        with open(a.ref_map) as f:
+            ref_map = {k: os.path.join(ROOT, v) if not os.path.isabs(v) else v for k, v in json.load(f).items()}
     cache = os.path.join(ROOT, "build", "bench-cache", "ms")
     os.makedirs(cache, exist_ok=True)
     os.makedirs(a.out, exist_ok=True)
@@ -344,7 +363,8 @@ def main():
         for k in ((1.0, a.thick) if thick and not a.quick else (1.0,)):
             scene = absolutise(thicken(base, k), folder)
             label = name if k == 1.0 else "%s x%g" % (name, k)
-            ref = reference(scene, label, w, h, spp * REF_SPP_SCALE.get(name, 1), ref_veil, cache, tmp)
+            ref = ref_map.get(label) or reference(scene, label, w, h, spp * REF_SPP_SCALE.get(name, 1), ref_veil,
+                                                  cache, tmp)
             for vname, ms, quality in variants:
                 if a.quick and vname.startswith("screen "):
                     continue
