@@ -24,8 +24,9 @@
  *    a ray (the linear part cancels). Counting order 1 twice would add the
  *    single scattering's mean, which the test first checks is far above
  *    that bound. Both ways the march reads the later light: from its lobe,
- *    and gathered towards the camera (render/shaders/cache_gather.comp, the
- *    default rung's), whose own noise enters as the spread of 8 renders
+ *    and gathered towards the camera (render/shaders/cache_gather.comp, 16
+ *    rays a cell, asked for: the default gathers only where g >= 1/sqrt(2)),
+ *    whose own noise enters as the spread of 8 renders
  *    with other seeds over the same cache (their mean: 5.5 standard errors,
  *    t with 7 degrees of freedom).
  * 4. Energy, in a closed case: a fog box of albedo 1 (no absorption,
@@ -517,12 +518,12 @@ static void no_double_count(veil_gl* gl)
     CHECK(veil_renderer_create(gl, &r, &err) == VEIL_OK, "%s", err.msg);
     double noise = 0.0, cell = 0.0; /* the cache's, from its report in the first mode (cached in the second) */
     for (int mode = 0; mode < 2; ++mode) {
-    /* mode 0: the later light from its lobe; 1: gathered towards the camera (the default rung's), which adds
+    /* mode 0: the later light from its lobe; 1: gathered towards the camera (16 rays a cell), which adds
      * its own noise: NS renders with other seeds (the same cache: it is seeded per volume) give NS means whose
      * spread s_g is that noise's; their mean has standard error s_g / sqrt(NS), taken 5.5 times (t with 7
      * degrees of freedom) in quadrature beside the rest */
     enum { NS = 8 };
-    s.multiple.cache_gather_rays = mode == 0 ? -1 : 0;
+    s.multiple.cache_gather_rays = mode == 0 ? -1 : 16; /* (isotropic: the default would not gather) */
     veil_image_set im = {0};
     veil_render_stats st = {0};
     double got_s[NS] = {0}, got = 0.0, gather_se = 0.0, multi = 0.0;
@@ -532,6 +533,9 @@ static void no_double_count(veil_gl* gl)
         CHECK(r && veil_render_scene_images(r, &s, &(veil_render_opts){.seed = 3u + (uint32_t)i}, &im, &st, &err) ==
                        VEIL_OK, "%s", err.msg);
         got_s[i] = im.rgba ? image_mean(im.rgba, pixels, 4) : 0.0;
+        CHECK((strstr(st.stage[VEIL_STAGE_RENDER].why, "gathered towards the camera") != NULL) == (mode == 1),
+              "mode %d: the render stage %s the later light: %s", mode, mode ? "gathers" : "does not gather",
+              st.stage[VEIL_STAGE_RENDER].why);
         got += got_s[i] / renders;
         multi += (im.aov_v ? image_mean(im.aov_v, pixels, 4) : 0.0) / renders;
     }
