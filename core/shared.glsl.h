@@ -389,10 +389,12 @@ VEIL_STRUCT_END(veil_diffusion_block)
 #define VEIL_CACHE_ENERGY_KINDS 7
 #define VEIL_CACHE_ENERGY_WORDS (2 * 3 * VEIL_CACHE_ENERGY_KINDS * VEIL_CACHE_ENERGY_GROUPS)
 #define VEIL_UBO_CACHE 7
-/* The cache is one rgba32f texture of four stacked grids (cells nx, ny, 4 nz): z in [0, nz) the fluence rgb
- * with the odd photons' luminance fluence in a, z in [nz, 2 nz) the luminance-weighted flux xyz, then the
- * same two of the later light alone (scattered more than once; emission: scattered), in [2 nz, 3 nz) and
- * [3 nz, 4 nz). One sampler reads them all (the march clamps z within a quarter, so filtering never crosses): on Mesa 22's
+/* The cache is one rgba32f texture of stacked grids (cells nx, ny, VEIL_CACHE_SLABS nz): z in [0, nz) the
+ * fluence rgb with the odd photons' luminance fluence in a, z in [nz, 2 nz) the luminance-weighted flux xyz
+ * with the cell's part outside a frame's solid in a, then the same two of the later light alone (scattered
+ * more than once; emission: scattered), in [2 nz, 3 nz) (a: the cell's majorant density) and [3 nz, 4 nz),
+ * and the gathered light in [4 nz, 5 nz) (below). One sampler reads them all (the march clamps z within a
+ * slab, so filtering never crosses): on Mesa 22's
  * llvmpipe a second 3D sampler read with texture() in the march returned 0 on all but the first
  * invocation of each row of a work group (texelFetch did not). */
 #define VEIL_IMAGE_CACHE 0         /* image unit: the cache, written by the resolve pass (and its slab 4 by the gather) */

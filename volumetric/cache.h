@@ -92,8 +92,9 @@ typedef struct veil_cache_programs {
 veil_result veil__cache_programs(veil_cache_programs* p, int sparse, int solid, veil_error* err);
 void veil__cache_programs_free(veil_cache_programs* p);
 
-/* At most this many cells (56 bytes each while built, 32 kept: 235 MB and
- * 134 MB): a grid that would have more is made coarser until it fits. */
+/* At most this many cells (196 bytes each while built: the 64-bit sums,
+ * majorant, free part and the texture; its 80 kept: 822 MB and 335 MB): a
+ * grid that would have more is made coarser until it fits. */
 #define VEIL_CACHE_MAX_CELLS (1 << 22)
 
 /* The grid: its min corner lo, cell edge h and dims, over the EV's box and
@@ -103,7 +104,7 @@ void veil__cache_programs_free(veil_cache_programs* p);
 int veil__cache_grid(const veil_lit_medium* md, int cells, float lo[3], float* h, int dims[3]);
 
 /* Builds the cache of md on the grid (lo, h, dims) into a new rgba32f
- * texture of dims[0] x dims[1] x 2 dims[2] texels: the fluence rgb (a: the
+ * texture of dims[0] x dims[1] x VEIL_CACHE_SLABS dims[2] texels (core/shared.glsl.h): the fluence rgb (a: the
  * odd photons' luminance fluence) at z < dims[2], the flux xyz above. The
  * medium block mu is md's (veil_lit_medium_fill). */
 veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md, const veil_medium_block* mu,

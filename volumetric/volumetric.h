@@ -53,7 +53,7 @@
 /* A field as the march reads it. */
 typedef struct veil_volumetric_field {
     GLuint texture;       /* rgba32f 3D, 0: none */
-    int depth;            /* the light cache: its grid's cells along z (the texture stacks two grids); else 0 */
+    int depth;            /* the light cache: its grid's cells along z (the texture stacks VEIL_CACHE_SLABS grids); else 0 */
     veil_field_kind kind; /* VEIL_FIELD_NONE when texture is 0 */
     float tex_min[3];     /* texture coordinates are (x - tex_min) * tex_inv */
     float tex_inv[3];

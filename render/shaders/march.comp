@@ -35,7 +35,10 @@
 // per step, weighted by the transmittance of a reduced extinction that
 // carries the forward peak of the phase function along the ray; the march
 // then ends where that transmittance, not T, is negligible (single
-// scattering stops where T is).
+// scattering stops where T is). With u.march.y > 0 the later light is not
+// read from its lobe but gathered towards the camera before the march
+// (render/shaders/cache_gather.comp, the cache's slab 4; render/march.h):
+// then the plain T, and no peak carried.
 // Emission (med.shape.w, in the variant compiled with VEIL_MARCH_EMISSION):
 // the EV's emission texture eps per step, integrated in closed form like
 // in-scattering, added to L (the medium's own light).
