@@ -4,25 +4,31 @@
 // cache's texture (core/shared.glsl.h), is what the march adds for the
 // light that reaches the camera after three or more scatterings, per unit
 // sigma_s rho at the cell's centre x:
-//   S(x) = integral over w of p(w . v) L2(x, w) dw,
-//   L2(x, w) = integral over s > 0 of T(x, y) sigma_s rho(y) J(y, w) ds,
-// y = x - s w, v the direction from x to the camera, w the direction the
+//   S(x) = integral over w of p(w . -v) L2(x, w) dw,
+//   L2(x, w) = integral over s > 0 of T_red(x, y) sigma_s rho(y) J(y, w) ds,
+// y = x - s w, v the direction from the camera to x, w the direction the
 // light travels, and J(y, w) the cache's light at y (once scattered and
-// later, each its HG lobe: render/shaders/cache_read.glsl) scattered
-// towards w. L2 is the light scattered at least twice arriving at x: one
+// later, each its HG lobe, the later one less its forward peak f = g^2:
+// render/shaders/cache_read.glsl) scattered towards w, the peak carried
+// along the ray by T_red, the transmittance of sigma_t - f sigma_s, as the
+// march carries it. L2 is the light scattered at least twice arriving at x: one
 // step of the transport equation away from the lobes, so their error at
 // the medium's skin — where the light towards the camera is what built up
 // along the ray behind x and no lobe about the flux holds it
 // (docs/multiple-scattering.md, "What the error is") — is integrated over
 // the medium along the ray instead of read at x.
-// Estimator: K = n^2 directions a cell, stratified n x n over the HG
-// phase function's inverse CDF in cos and the azimuth (so p/pdf = 1), the
-// strata shifted by the cell's own random offset (Cranley-Patterson); each
-// direction's ray marched in steps of half a cell, midpoint density (the
-// fogs in closed form), in-scattering integrated over a step as the march
-// does, until T < VEIL_MIN_TRANSMITTANCE or the grid's edge (or, with
-// VEIL_SOLID, a frame's surface). The random numbers of cell c come from
-// (seed, c) alone: the same camera and cache give the same slab.
+// Estimator: K = n^2 directions a cell, stratified n x n over an inverse
+// CDF in cos and the azimuth, the strata shifted by the cell's own random
+// offset (Cranley-Patterson); on a checkerboard of the strata the CDF is
+// the phase function's about -v or the lobe's of all the light at x (HG of
+// its mean cosine about its flux), each ray weighted by the balance
+// heuristic in the two's shares. Each ray is marched in steps of u.march.z
+// of the cache's cells (split above VEIL_GATHER_MAX_OPT), midpoint density
+// (the fogs in closed form), in-scattering integrated over a step as the
+// march does, until T_red < VEIL_MIN_TRANSMITTANCE or the grid's edge (or,
+// with VEIL_SOLID, a frame's surface). Cells the march never reads are
+// skipped (main, seen()). The random numbers of cell c come from (seed, c)
+// alone: the same camera and cache give the same slab.
 layout(local_size_x = VEIL_GATHER_GROUP, local_size_y = VEIL_GATHER_GROUP, local_size_z = VEIL_GATHER_GROUP) in;
 layout(binding = VEIL_TEX_DIFFUSION) uniform sampler3D u_phi; // the cache (slabs 0-3 read)
 layout(binding = VEIL_IMAGE_CACHE, rgba32f) writeonly uniform image3D u_cache; // its slab 4 written
