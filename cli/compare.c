@@ -7,8 +7,8 @@
  *    "rmse", "max_abs", "off_5pct", "psnr_db", "alpha_max_abs",
  *    "heatmap": path or null}
  * plus "bin", "mean_bias" and, when REF holds the standard errors that
- * `veil reference` writes (stderr.R, .G, .B), "noise" and
- * "rel_rmse_excess" (null without them).
+ * `veil reference` writes (stderr.R, .G, .B), "noise", "rel_rmse_excess"
+ * and "mean_bias_se" (null without them).
  * --bin B compares the means of B x B pixel blocks (a partial block at an
  * edge dropped): the reference's noise falls B times, systematic errors
  * stay. mean_bias = mean(A RGB) / mean(REF RGB) - 1. noise is the rms of
@@ -16,7 +16,9 @@
  * alike; a pixel whose stderr.bound is 1 adds no noise: its error is a
  * bound, not an estimate); rel_rmse_excess = sqrt(max(0, rel_rmse^2 - noise^2)) is the
  * image's own error with the reference's noise taken out (they add in
- * quadrature, being independent).
+ * quadrature, being independent). mean_bias_se is mean_bias's standard
+ * error from the reference's noise (veil_compare_bias_se): a bias within
+ * two or three of it is not one the reference can tell from 0.
  * Numbers are JSON numbers; "psnr_db" is null when the images' RGB are
  * identical (MSE 0, PSNR infinite; the text form prints "inf"). No NaN is
  * ever printed: every other number is finite for finite inputs.
@@ -132,7 +134,7 @@ static void print_json_number(const char* key, double v, const char* after)
 }
 
 typedef struct extra_stats {
-    double bias, noise, excess; /* noise, excess: NAN without standard errors */
+    double bias, noise, excess, bias_se; /* noise, excess, bias_se: NAN without standard errors */
     size_t bounded;             /* reference pixels whose standard error is a bound (not counted as noise) */
 } extra_stats;
 
@@ -154,6 +156,7 @@ static void print_json(const compare_args* a, const veil_compare_stats* st, cons
     print_json_number("mean_bias", x->bias, ",\n");
     print_json_number("noise", x->noise, ",\n");
     print_json_number("rel_rmse_excess", x->excess, ",\n");
+    print_json_number("mean_bias_se", x->bias_se, ",\n");
     fputs("  \"heatmap\": ", stdout);
     if (a->heatmap) print_json_string(a->heatmap);
     else fputs("null", stdout);
@@ -186,6 +189,7 @@ static void print_text(const compare_args* a, const veil_compare_stats* st, cons
     if (isfinite(x->noise))
         printf("noise          %.6g (reference's standard error, relative%s)\nrel_rmse_excess %.6g (noise taken out)\n",
                x->noise, x->bounded ? "; pixels whose error is a bound add none" : "", x->excess);
+    if (isfinite(x->bias_se)) printf("mean_bias_se   %.6g (mean_bias's standard error from the reference's noise)\n", x->bias_se);
     if (a->heatmap) {
         char lo[16], hi[16], blue[16], magenta[16], yellow[16];
         decade(VEIL_COMPARE_HEATMAP_MIN, lo), decade(VEIL_COMPARE_HEATMAP_MAX, hi);
@@ -298,7 +302,7 @@ int veil_cmd_compare(int argc, char** argv)
             r = veil_fail(&err, VEIL_ERR_OOM, "%s: out of memory for a %dx%d heatmap", a.heatmap, wa, ha);
     }
     veil_compare_stats st = {0};
-    extra_stats x = {0.0, NAN, NAN, 0};
+    extra_stats x = {0.0, NAN, NAN, NAN, 0};
     float* se = NULL;
     if (r == VEIL_OK) {
         /* the reference's standard errors, when it has them */
@@ -328,6 +332,7 @@ int veil_cmd_compare(int argc, char** argv)
             x.noise = veil_compare_noise(ref, se, wa, ha, st.floor);
             double e = st.rel_rmse * st.rel_rmse - x.noise * x.noise;
             x.excess = e > 0.0 ? sqrt(e) : 0.0;
+            x.bias_se = veil_compare_bias_se(img, ref, se, wa, ha);
         }
     }
     if (r == VEIL_OK && a.heatmap) r = write_heatmap(a.heatmap, wa, ha, rel, &err);

@@ -177,6 +177,23 @@ double veil_compare_bias(const float* a, const float* b, int width, int height)
     return sa / sb - 1.0;
 }
 
+double veil_compare_bias_se(const float* a, const float* b, const float* se, int width, int height)
+{
+    double sa = 0.0, sb = 0.0, var = 0.0;
+    size_t n = (size_t)width * (size_t)height;
+    for (size_t i = 0; i < n; ++i) {
+        double s = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            sa += a[4 * i + (size_t)c];
+            sb += b[4 * i + (size_t)c];
+            s += se[3 * i + (size_t)c];
+        }
+        var += s * s;
+    }
+    if (sb == 0.0) return sa == 0.0 ? 0.0 : NAN;
+    return sa / sb * sqrt(var) / fabs(sb);
+}
+
 double veil_compare_noise(const float* b, const float* se, int width, int height, double floor)
 {
     double sum = 0.0;

@@ -74,6 +74,13 @@ veil_result veil_compare_bin(const float* rgba, const float* se, int w, int h, i
  * - 1 (0 when both are black; NaN, undefined, when only b is: callers say so rather than print a number). */
 double veil_compare_bias(const float* a, const float* b, int width, int height);
 
+/* The standard error of veil_compare_bias that the reference's noise alone gives it (se: 3 floats a
+ * pixel, its standard errors): (sum a / sum b) sd(sum b) / sum b over the RGB of every pixel, with
+ * sd(sum b)^2 = the sum over pixels of (se_R + se_G + se_B)^2. A pixel's three channels come from the
+ * same paths: taken as wholly correlated, which never understates it. A few pixels of heavy-tailed
+ * noise (a point light inside a medium) can hold most of it. NaN where the bias is undefined. */
+double veil_compare_bias_se(const float* a, const float* b, const float* se, int width, int height);
+
 /* The reference's own noise on the scale of the relative RMSE: the rms
  * over pixels and channels of se / max(|b|, floor). A measured rel_rmse
  * holds this noise in quadrature (the reference's error is independent of

@@ -90,15 +90,19 @@ grep -q '^rel_rmse .*(floor 2)$' "$tmp/out" || fail "--floor 2 not stated: $(cat
 
 # mean bias: scaled by 1.1 is +10 % energy; identical images 0
 run "$d/scaled.exr" "$d/ref.exr" --json
-json_check "close(j['mean_bias'], 0.1, 1e-5) and j['noise'] is None and j['rel_rmse_excess'] is None and j['bin'] == 1" \
-  "mean_bias"
+json_check "close(j['mean_bias'], 0.1, 1e-5) and j['noise'] is None and j['rel_rmse_excess'] is None \
+            and j['mean_bias_se'] is None and j['bin'] == 1" "mean_bias"
 # the reference's standard error is 2 % of each value (all above the floor): noise 0.02, and
 # the excess is sqrt(0.1^2 - 0.02^2) = 0.09798
 run "$d/scaled.exr" "$d/ref_se.exr" --json
 json_check "close(j['noise'], 0.02, 1e-5) and close(j['rel_rmse_excess'], math.sqrt(0.01 - 0.0004), 1e-5)" "noise"
+# the bias's standard error: 1.1 x 0.02 sqrt(sum s^2) / sum s over the pixels' RGB sums s (a pixel's
+# channels' errors added, as wholly correlated)
+json_check "close(j['mean_bias_se'], 1.1 * 0.02 * math.sqrt(sum(sum(p[:3])**2 for p in ref)) / sum(sum(p[:3]) for p in ref), 1e-5)" \
+  "mean_bias_se"
 # every error a bound: no noise is taken out
 run "$d/scaled.exr" "$d/ref_bound.exr" --json
-json_check "j['noise'] == 0 and close(j['rel_rmse_excess'], 0.1, 1e-5)" "stderr.bound"
+json_check "j['noise'] == 0 and close(j['rel_rmse_excess'], 0.1, 1e-5) and j['mean_bias_se'] == 0" "stderr.bound"
 # standard errors that are not ones (issue 22): refused, naming the channel and the pixel
 run "$d/scaled.exr" "$d/ref_se_nan.exr" --json
 [ $rc -eq 1 ] && grep -q "channel stderr.G at pixel (3, 2) is not a number" "$tmp/err" \
