@@ -180,8 +180,10 @@ VEIL_STRUCT_BEGIN(veil_march_block)
     VEIL_V4(cam_up);       /* xyz: up, scaled by tan(fov/2) */
     VEIL_V4(background);   /* rgb: radiance behind the medium */
     VEIL_V4(march);        /* x: step (m); the cache's gather (render/shaders/cache_gather.comp): y its rays a cell (0: off),
-                              z its steps in the cache's cells, w the cache's cells a side of one of its cells */
-    VEIL_V4(limits);       /* x: no step starts at or beyond this distance (m; 3e38: no limit) */
+                              z its steps in the cache's cells, w the cache's cells a side of one of its cells
+                              (a real >= 1: its grid in u.limits.yzw) */
+    VEIL_V4(limits);       /* x: no step starts at or beyond this distance (m; 3e38: no limit); yzw: the gather's
+                              cells along x, y, z (u.march.w of the cache's a side each) */
     VEIL_IV4(size);        /* x, y: image size (pixels); z: the first row of this dispatch's band */
     VEIL_UV4(flags);       /* x: -, y: skip empty bricks, z: jitter seed, w: per-pixel end */
     VEIL_V4(octave);       /* volumetric multiple scattering: x: a, y: b, z: c, w: octaves (0: off) */
@@ -405,7 +407,8 @@ VEIL_STRUCT_END(veil_diffusion_block)
 #define VEIL_GATHER_GROUP 4        /* 4^3 cells a work group of the gather */
 #define VEIL_GATHER_MAX_OPT 0.5    /* the gather's steps split above this optical thickness (reduced extinction) */
 #define VEIL_GATHER_MAX_LOBE 0.9   /* the gather's second technique: the light's lobe at most this peaked */
-#define VEIL_GATHER_MAX_CELLS 64   /* the gather's cells along the grid's longest side, at most (coarser: s^3 cache cells) */
+#define VEIL_GATHER_MAX_CELLS 64   /* the gather's cells along the grid's longest side, at most, where the march
+                                      is not told (render/march.h gather_cells; coarser: cubes of s cache cells) */
 /* The photons' work (steps: a piece of path in a cell, or a tentative
  * collision). volumetric/cache.c estimates the steps a photon takes from
  * the cells' majorants; the photons of a cache take at most

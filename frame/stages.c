@@ -520,6 +520,7 @@ static veil_result render_build(veil_frame* f, veil_stage_report* rep, veil_erro
     const int peaked = ph->type == VEIL_PHASE_HG && ph->g >= VEIL_GATHER_MIN_G;
     md.gather_rays = gather < 0 ? 0 : gather > 0 ? gather : peaked ? q->gather_rays : 0;
     md.gather_step = q->gather_step > 0.0f ? q->gather_step : 1.0f;
+    md.gather_cells = q->gather_cells;
     if (f->solid.voxels) { /* what the lights and the cache saw of the frame's surfaces */
         size_t len = strlen(rep->why);
         snprintf(rep->why + len, sizeof rep->why - len, "; the frame's surfaces as a solid (scene/solid.h): "

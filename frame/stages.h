@@ -83,6 +83,7 @@ typedef struct veil_quality_rung {
     int cache_cells;
     int gather_rays;         /* the cache's later light gathered towards the camera: rays a cell (0: off) */
     float gather_step;       /* and its rays' steps, in the cache's cells (render/march.h) */
+    int gather_cells;        /* and its cells along the grid's longest side, at most */
 } veil_quality_rung;
 const veil_quality_rung* veil_quality_rung_of(veil_quality q); /* UNSET: the default rung */
 

@@ -107,14 +107,19 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
         set3(u->diffusion, d->field->tex_min, (float)d->field->kind);
         set3(u->diffusion_inv, d->field->tex_inv, (float)d->field->depth);
         if (d->field->kind == VEIL_FIELD_CACHE && d->gather_rays > 0 && d->field->depth > 0) {
-            /* the gather's grid: at most VEIL_GATHER_MAX_CELLS a side, s^3 of the cache's cells a cell */
+            /* the gather's grid (gather_cells, else VEIL_GATHER_MAX_CELLS): cubes of s of the cache's cells */
             GLint n[3] = {0, 0, d->field->depth};
             glGetTextureLevelParameteriv(d->field->texture, 0, GL_TEXTURE_WIDTH, &n[0]);
             glGetTextureLevelParameteriv(d->field->texture, 0, GL_TEXTURE_HEIGHT, &n[1]);
             const int longest = n[0] > n[1] ? (n[0] > n[2] ? n[0] : n[2]) : (n[1] > n[2] ? n[1] : n[2]);
             u->march[1] = (float)d->gather_rays;
             u->march[2] = d->gather_step > 0.0f ? d->gather_step : 1.0f;
-            u->march[3] = (float)((longest + VEIL_GATHER_MAX_CELLS - 1) / VEIL_GATHER_MAX_CELLS);
+            /* a grid of G cells along the longest side, each s = longest / G of the cache's cells a side (s >= 1),
+             * and ceil(n / s) = ceil(n G / longest) cells along a side of n (the shaders read these counts) */
+            const int G = d->gather_cells > 0 ? d->gather_cells : VEIL_GATHER_MAX_CELLS;
+            const int gc = longest > G ? G : longest;
+            u->march[3] = (float)longest / (float)gc;
+            for (int a = 0; a < 3; ++a) u->limits[1 + a] = (float)((n[a] * gc + longest - 1) / longest);
         }
     }
     /* the octaves: asked for, or in place of a light cache that could not be made (a fog box too wide for
@@ -215,13 +220,10 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
             const int gv = (lm->grid && lm->sparse ? 2 : 0) + (mu.solid_origin[3] > 0.0f ? 1 : 0);
             r = gather_variant(m, gv, err);
             if (r == VEIL_OK) {
-                GLint nx = 0, ny = 0;
-                glGetTextureLevelParameteriv(d->field->texture, 0, GL_TEXTURE_WIDTH, &nx);
-                glGetTextureLevelParameteriv(d->field->texture, 0, GL_TEXTURE_HEIGHT, &ny);
                 glUseProgram(m->gather[gv]);
                 glBindImageTexture(VEIL_IMAGE_CACHE, d->field->texture, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-                const int sc = (int)u.march[3];
-                const int gd[3] = {(nx + sc - 1) / sc, (ny + sc - 1) / sc, (d->field->depth + sc - 1) / sc};
+                const float sc = u.march[3];
+                const int gd[3] = {(int)u.limits[1], (int)u.limits[2], (int)u.limits[3]};
                 glDispatchCompute(veil_groups(gd[0], VEIL_GATHER_GROUP), veil_groups(gd[1], VEIL_GATHER_GROUP),
                                   veil_groups(gd[2], VEIL_GATHER_GROUP));
                 glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);

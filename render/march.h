@@ -59,11 +59,14 @@ typedef struct veil_march_desc {
                                   (render/shaders/cache_gather.comp; rounded to a square); 0: from its lobe.
                                   By default (frame/) where HG g >= VEIL_GATHER_MIN_G */
     float gather_step;         /* the gather's steps along its rays, in the cache's cells (> 0) */
+    int gather_cells;          /* the gather's cells along the cache grid's longest side, at most (each then
+                                  longest / gather_cells of the cache's a side); 0: VEIL_GATHER_MAX_CELLS */
 } veil_march_desc;
 
 /* What the last veil_march_run gathered (render/shaders/cache_gather.comp): rays 0 when it did not. */
 typedef struct veil_march_gather {
-    int rays, scale, dims[3]; /* rays a cell (a square), the cache's cells a side of one, its cells */
+    int rays, dims[3];        /* rays a cell (a square), its cells */
+    float scale;              /* the cache's cells a side of one of its cells (>= 1) */
     float step;               /* its rays' steps, in the cache's cells */
     double ms;                /* its time, apart from the march's */
 } veil_march_gather;

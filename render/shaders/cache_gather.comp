@@ -73,15 +73,15 @@ bool seen(vec3 x, vec3 rel, vec3 lo, vec3 hi, float r, float h)
 
 void main()
 {
-    // the gather's cells: the cache's, or s^3 of them (u.march.w = s) in one
-    const int sc = max(int(u.march.w), 1);
+    // the gather's cells (u.limits.yzw): the cache's, or cubes of s (u.march.w >= 1) of the cache's a side
+    const float sc = max(u.march.w, 1.0);
     ivec3 dims = ivec3(imageSize(u_cache).xy, int(u.diffusion_inv.w));
-    ivec3 gdims = (dims + sc - 1) / sc;
+    ivec3 gdims = ivec3(u.limits.yzw);
     ivec3 c = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(c, gdims))) return;
     // only cells the march reads: those with density within one cell (the majorants, slab 2's alpha)
     bool near = false;
-    ivec3 f0 = max(c * sc - sc, ivec3(0)), f1 = min(c * sc + 2 * sc, dims);
+    ivec3 f0 = max(ivec3(floor(vec3(c - 1) * sc)), ivec3(0)), f1 = min(ivec3(ceil(vec3(c + 2) * sc)), dims);
     for (int z = f0.z; z < f1.z && !near; ++z)
         for (int y = f0.y; y < f1.y && !near; ++y)
             for (int x = f0.x; x < f1.x && !near; ++x)
@@ -92,9 +92,11 @@ void main()
     }
     vec3 lo = u.diffusion.xyz, hi = lo + 1.0 / u.diffusion_inv.xyz;
     float h = (hi.x - lo.x) / float(dims.x);
-    vec3 x = lo + (vec3(c) + 0.5) * (float(sc) * h);
+    // its centre, or for a last cell partly past the grid's side (s not dividing the cells) the nearest
+    // point half a cache cell inside: the march reads it there, between its neighbour and the side
+    vec3 x = lo + min((vec3(c) + 0.5) * sc, vec3(dims) - 0.5) * h;
     vec3 v = x - u.cam_pos.xyz;
-    if (!seen(x, v, lo, hi, 2.0 * 1.7320508 * float(sc) * h, h)) {
+    if (!seen(x, v, lo, hi, 2.0 * 1.7320508 * sc * h, h)) {
         imageStore(u_cache, c + ivec3(0, 0, 4 * dims.z), vec4(0.0));
         return;
     }

@@ -28,10 +28,10 @@ bool cache_fetch(vec3 x, bool want_gathered, out vec3 phi1, out vec3 F1, out vec
     phi2 = texture(u_phi, vec3(c.xy, (z + 2.0 * nz) / (slabs * nz))).rgb;
     F2 = texture(u_phi, vec3(c.xy, (z + 3.0 * nz) / (slabs * nz))).xyz;
     if (want_gathered) {
-        // the gather's cells are s (u.march.w) of the cache's a side, from the same corner; the slab's
-        // texels past them are never read
+        // the gather's cells (u.limits.yzw) are s (u.march.w) of the cache's a side, from the same
+        // corner; the slab's texels past them are never read
         float sc = max(u.march.w, 1.0);
-        vec3 n = vec3(textureSize(u_phi, 0).xy, nz), gn = ceil(n / sc);
+        vec3 n = vec3(textureSize(u_phi, 0).xy, nz), gn = u.limits.yzw;
         vec3 t = clamp(c * n / sc, vec3(0.5), gn - 0.5);
         gathered = texture(u_phi, vec3(t.xy / n.xy, (t.z + 4.0 * nz) / (slabs * nz))).rgb;
     }

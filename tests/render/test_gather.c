@@ -35,7 +35,9 @@
  *    layers nearest and furthest from the camera by far.
  * 2. The same seed gives the same values, bit for bit.
  * 3. The march reads them where they are: a grid of 72 x 8 x 8 cells is
- *    gathered on cells of 2^3 (VEIL_GATHER_MAX_CELLS 64), and a pixel's
+ *    gathered on 48 cells along x (gather_cells), 1.5 of the cache's a
+ *    side each: 48 x 6 x 6 of them (the last, along y and z, partly
+ *    outside the grid), and a pixel's
  *    march against the integral of T sigma_s rho S along its ray, S read
  *    trilinearly from those gathered cells as the GPU left them (so no
  *    sampling error): the march takes midpoint steps of at most Delta; a
@@ -186,6 +188,8 @@ static GLuint make_cache(const box_case* bc, veil_volumetric_field* f)
 }
 
 /* One march (and its gather) of a w x h image; the image's rgba (caller frees) and slab 4 into out. */
+static int g_gather_cells; /* the march's gather_cells (0: its default) */
+
 static float* march(veil_march* m, const box_case* bc, const veil_volumetric_field* f, int rays, uint32_t seed,
                     int w, int h, const float look_at[3], float fov, float* out)
 {
@@ -195,7 +199,7 @@ static float* march(veil_march* m, const box_case* bc, const veil_volumetric_fie
                        .width = w, .height = h};
     veil_march_desc d = {.medium = {.scene = &g_scene, .opv = opv}, .camera = &cam, .width = w, .height = h,
                          .step_voxels = 0.5f, .seed = seed, .no_background = 1, .field = f,
-                         .gather_rays = rays, .gather_step = (float)bc->step};
+                         .gather_rays = rays, .gather_step = (float)bc->step, .gather_cells = g_gather_cells};
     veil_image_set im = {0};
     veil_error err = {0};
     CHECK(veil_march_run(m, &d, &im, &err) == VEIL_OK, "march: %s", err.msg);
@@ -263,7 +267,7 @@ static void cells_against_closed_form(veil_march* m, const box_case* bc, int ray
 }
 
 /* Trilinear read of the gathered cells (gdims) at x, as cache_read.glsl reads them. */
-static void gathered_at(const box_case* bc, const float* s4, const int gd[3], int sc, const double x[3], double out[3])
+static void gathered_at(const box_case* bc, const float* s4, const int gd[3], double sc, const double x[3], double out[3])
 {
     double t[3];
     int i0[3], i1[3];
@@ -296,9 +300,15 @@ static void march_reads_gathered(veil_march* m)
     const size_t cells = (size_t)72 * 8 * 8;
     float* s4 = calloc(4 * cells, sizeof *s4);
     const float look[3] = {-2.0f, 0.0f, 0.0f};
+    g_gather_cells = 48;
     float* px = march(m, &bc, &f, 16, 1, 1, 1, look, 20.0f, s4);
-    const int sc = (72 + VEIL_GATHER_MAX_CELLS - 1) / VEIL_GATHER_MAX_CELLS, gd[3] = {72 / sc, 8 / sc, 8 / sc};
-    CHECK(sc == 2, "a 72-cell grid is gathered on cells of %d", sc);
+    g_gather_cells = 0;
+    const veil_march_gather lg = veil_march_last_gather(m);
+    const double sc = lg.scale;
+    const int gd[3] = {48, 6, 6}; /* ceil(8 / 1.5) = 6 */
+    CHECK(lg.scale == 1.5f && lg.dims[0] == gd[0] && lg.dims[1] == gd[1] && lg.dims[2] == gd[2],
+          "a 72-cell grid gathered on 48 cells a side: cells of %g, %dx%dx%d of them", (double)lg.scale, lg.dims[0],
+          lg.dims[1], lg.dims[2]);
     if (px && s4) {
         /* the pixel's ray: the 1x1 camera looks along its forward axis */
         double o[3] = {bc.cam[0], bc.cam[1], bc.cam[2]}, d[3], n = 0.0;
@@ -333,7 +343,7 @@ static void march_reads_gathered(veil_march* m)
             double tol = K[c] * delta * (t1 - t0) / 4.0 + 1e-5 * want[c];
             CHECK(fabs(px[c] - want[c]) <= tol, "march ch %d: %.6g against the gathered cells' integral %.6g (bound %.3g)",
                   c, px[c], want[c], tol);
-            printf("march reads the gathered cells (2^3 cache cells each), ch %d: %.6g against %.6g, bound %.2g\n", c,
+            printf("march reads the gathered cells (1.5^3 cache cells each), ch %d: %.6g against %.6g, bound %.2g\n", c,
                    px[c], want[c], tol);
         }
     }
