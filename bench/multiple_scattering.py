@@ -352,7 +352,7 @@ def main():
     os.makedirs(cache, exist_ok=True)
     os.makedirs(a.out, exist_ok=True)
     tmp = tempfile.mkdtemp(prefix="veil-ms-")
-    wanted = [s for s in a.scenes.split(",") if s]
+    wanted = [s for s in a.scenes.split(";" if ";" in a.scenes else ",") if s]
     rows = []
     variants = VARIANTS + (CANDIDATES if a.candidates else []) + (STUDY if a.study else [])
     if a.converge:
