@@ -10,6 +10,9 @@
 #   make peers  veil against OpenVDB's vdb_render, time against error on three VDBs
 #               (bench/peers.py: installs libopenvdb-tools and gnuplot; ~30 minutes the
 #               first time, the references then cached; PEERS_ARGS="--quick": minutes)
+#   make bench-regress BASE=<commit>  this tree's veil against BASE's (built in a worktree under
+#               build/regress/), stage by stage and whole process, in turn on a fixed set of scenes
+#               (bench/regress.py; REGRESS_ARGS="--runs 7 --scenes demo,cloud"): a benchmark, not a test
 #   make fuzz   libFuzzer on the scene parser, the particle readers, the EXR and
 #               the OpenVDB readers, frame patterns and a run's files, FUZZ_SECONDS each (default 60), under ASan and
 #               UBSan, in build-fuzz/ (scripts/fuzz.sh)
@@ -20,7 +23,7 @@
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
-.PHONY: all deps build demo test data clean accuracy test-sanitize fuzz peers test-farm
+.PHONY: all deps build demo test data clean accuracy test-sanitize fuzz peers test-farm bench-regress
 FUZZ_SECONDS ?= 60
 
 all: build
@@ -65,6 +68,12 @@ accuracy:
 	@$(MAKE) --no-print-directory build
 	@test -f data/generated/smoke_plume.vdb || $(MAKE) --no-print-directory data
 	@$(BUILD)/bench/accuracy $(if $(FULL),,--quick) $(ACCURACY_ARGS)
+
+bench-regress:
+	@test -n "$(BASE)" || { echo "make bench-regress: name the commit to compare with: BASE=<commit>" >&2; exit 2; }
+	@$(MAKE) --no-print-directory deps
+	@$(MAKE) --no-print-directory data
+	@/usr/bin/python3 bench/regress.py --base $(BASE) $(REGRESS_ARGS)
 
 peers:
 	@$(MAKE) --no-print-directory deps
