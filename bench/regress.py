@@ -174,6 +174,10 @@ def main():
     for w in wanted:
         if w not in known:
             ap.error("--scenes: no scene '%s' (%s)" % (w, ", ".join(known)))
+    for opt, commit in (("--base", a.base), ("--new", a.new)):
+        if commit and subprocess.run(["git", "-C", ROOT, "rev-parse", "--verify", "--quiet", commit + "^{commit}"],
+                                     stdout=subprocess.DEVNULL).returncode != 0:
+            ap.error("%s %s: not a commit of this repository" % (opt, commit))
     try:
         sha, base = build_base(a.base)
         if a.new:
