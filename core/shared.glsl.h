@@ -156,18 +156,21 @@ VEIL_STRUCT_BEGIN(veil_medium_block)
     VEIL_V4(sigma_t);      /* rgb: m^-1 per unit density */
     VEIL_V4(sigma_s);      /* rgb: m^-1 per unit density */
     VEIL_V4(shape);        /* x: floor on |S - X|^2 (m^2), y: voxel (m), z: HG g, w: 1 with emission */
-    VEIL_IV4(counts);      /* x: lights, y: fogs, z: 1 with a volume (the EV), w: - */
+    VEIL_IV4(counts);      /* x: lights, y: fogs, z: 1 with a volume (the EV), w: lights read from the OPVs
+                              (on_opv; the other x - w from light-space grids: sun_step[k].w) */
     veil_gpu_light lights[VEIL_MAX_LIGHTS];
     veil_gpu_fog fogs[VEIL_MAX_FOGS];
     VEIL_IV4(sun_of[VEIL_MAX_LIGHTS / 4]); /* [l / 4][l % 4]: 1 + the light-space grid holding light l's
                                               optical depth; 0: its channel of the OPVs */
     VEIL_V4(sun_map[3 * VEIL_MAX_SUNS]);   /* 3k .. 3k+2: grid k's world -> texture rows (xyz . x + w) */
     VEIL_V4(sun_step[VEIL_MAX_SUNS]);      /* grid k: x: node spacing along the light (m), y: nodes along it,
-                                              z: density samples of the last stretch (propagate/shaders/lit_medium.glsl) */
+                                              z: density samples of the last stretch (propagate/shaders/lit_medium.glsl),
+                                              w: the light it holds */
     VEIL_V4(solid_origin); /* xyz: the frame's solid's min corner (m); w: its voxel (m), 0: no solid (scene/solid.h) */
     VEIL_IV4(solid_dims);  /* xyz: its voxels an axis; w: shadow maps (light l < w has layer l) */
     VEIL_V4(shadow[3 * VEIL_MAX_LIGHTS]);  /* light l: 3l, 3l+1: a sun's map coordinates dot(x, xyz) + w;
                                               3l+2: x: bias (m), y: bias per m along the light's path */
+    VEIL_IV4(on_opv[VEIL_MAX_LIGHTS / 4]); /* [i / 4][i % 4], i < counts.w: the lights read from the OPVs, in order */
 VEIL_STRUCT_END(veil_medium_block)
 
 /* What the ray marcher (render/shaders/march.comp) reads besides the

@@ -57,7 +57,10 @@ void veil_lit_medium_fill(const veil_lit_medium* d, veil_medium_block* u)
         u->sun_step[k][0] = along * d->grid->voxel;
         u->sun_step[k][1] = (float)d->suns[k].space.nodes[2];
         u->sun_step[k][2] = ceilf(along); /* pieces of at most a voxel, as the prefix sum's panels */
+        u->sun_step[k][3] = (float)l;
     }
+    for (int l = 0; l < n; ++l) /* the rest, in order */
+        if (u->sun_of[l / 4][l % 4] == 0) u->on_opv[u->counts[3] / 4][u->counts[3] % 4] = l, ++u->counts[3];
     const veil_solid* so = d->solid;
     if (so && so->voxels && d->solid_voxels && d->solid_maps) {
         set3(u->solid_origin, so->origin, so->voxel);

@@ -2,6 +2,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -11,13 +12,27 @@
 #include "../gpu/programs.h"
 #include "../scene/camera.h"
 
-/* The march's variants: march.comp with VEIL_SPARSE (a sparse volume), VEIL_MARCH_EMISSION (the volume
- * glows) and VEIL_SOLID (a frame's surfaces shadow the lights: scene/solid.h) defined or not, program[] at
- * 4 sparse + 2 emission + solid. The first two are made with the march, the rest when first needed. */
-enum { MARCH_SPARSE = 4, MARCH_EMISSION = 2, MARCH_SOLID = 1, MARCH_VARIANTS = 8 };
+/* The march's programs: march.comp with defines for what llvmpipe would otherwise pay for in every
+ * sample, since it runs both sides of each branch it cannot fold, texture reads included:
+ * VEIL_SPARSE (a sparse volume), VEIL_MARCH_EMISSION (the volume glows), VEIL_SOLID (a frame's surfaces
+ * shadow the lights: scene/solid.h), VEIL_MARCH_FIELD (the field u_phi holds: a VEIL_FIELD_*),
+ * VEIL_MARCH_GATHER (the cache's later light gathered), and for a large frame VEIL_LIGHT_LIST (the
+ * lights, each one's kind and light-space grid: VEIL_MARCH_LIGHT_LIST_WORK). A loop over the lights
+ * that read each one's kind and grid from the medium's block paid for a sun's grid lookup and its
+ * stretch of density in every light's every sample: 1.35x the demo's march (docs/performance.md).
+ * Programs are made when first needed and the last MARCH_PROGRAMS kept, keyed by their defines (a
+ * turntable's frames share one). */
+enum { MARCH_PROGRAMS = 12 };
+
+typedef struct {
+    GLuint program;
+    char defines[VEIL_MAX_LIGHTS * 24 + 192];
+} march_program;
 
 struct veil_march {
-    GLuint program[MARCH_VARIANTS], ubo, medium_ubo;
+    march_program programs[MARCH_PROGRAMS];
+    int next; /* the slot a new program takes (the oldest) */
+    GLuint ubo, medium_ubo;
     GLuint gather[4]; /* render/shaders/cache_gather.comp, at 2 sparse + solid; made when first needed */
     veil_march_gather last_gather;
 };
@@ -33,15 +48,50 @@ static veil_result gather_variant(veil_march* m, int v, veil_error* err)
     return veil_gpu_program_variant("render/shaders/cache_gather.comp", defines[v], names[v], &m->gather[v], err);
 }
 
-static veil_result variant(veil_march* m, int v, veil_error* err)
+/* Appends to a fixed buffer (march_program's is sized for the longest list). */
+static void append(char* dst, size_t cap, const char* fmt, int a, int b, int c)
 {
-    if (m->program[v]) return VEIL_OK;
-    if (v == 0) return veil_gpu_program("render/shaders/march.comp", &m->program[0], err);
-    char defines[128] = "", name[64] = "";
-    if (v & MARCH_SPARSE) strcat(defines, "#define VEIL_SPARSE 1\n"), strcat(name, "sparse");
-    if (v & MARCH_EMISSION) strcat(defines, "#define VEIL_MARCH_EMISSION 1\n"), strcat(name, *name ? ", emission" : "emission");
-    if (v & MARCH_SOLID) strcat(defines, "#define VEIL_SOLID 1\n"), strcat(name, *name ? ", solid" : "solid");
-    return veil_gpu_program_variant("render/shaders/march.comp", defines, name, &m->program[v], err);
+    size_t n = strlen(dst);
+    if (n < cap) snprintf(dst + n, cap - n, fmt, a, b, c);
+}
+
+/* The march's program for this frame: the medium's block mu, the march's u, the lights compiled in
+ * or not. */
+static veil_result program_for(veil_march* m, const veil_lit_medium* lm, const veil_medium_block* mu,
+                               const veil_march_block* u, int light_list, GLuint* out, veil_error* err)
+{
+    march_program want;
+    memset(&want, 0, sizeof want);
+    const size_t cap = sizeof want.defines;
+    char name[96] = "";
+    if (lm->grid && lm->sparse) append(want.defines, cap, "#define VEIL_SPARSE 1\n", 0, 0, 0), strcat(name, "sparse, ");
+    if (lm->grid && lm->emission)
+        append(want.defines, cap, "#define VEIL_MARCH_EMISSION 1\n", 0, 0, 0), strcat(name, "emission, ");
+    if (mu->solid_origin[3] > 0.0f) append(want.defines, cap, "#define VEIL_SOLID 1\n", 0, 0, 0), strcat(name, "solid, ");
+    if (light_list) { /* and the field with them (march.comp says why not apart) */
+        const int field = (int)u->diffusion[3];
+        append(want.defines, cap, "#define VEIL_MARCH_FIELD %d\n#define VEIL_MARCH_GATHER %d\n", field, u->march[1] > 0.0f, 0);
+        snprintf(name + strlen(name), sizeof name - strlen(name), "field %d%s, ", field, u->march[1] > 0.0f ? ", gathered" : "");
+        append(want.defines, cap, "#define VEIL_LIGHT_LIST", 0, 0, 0);
+        for (int l = 0; l < mu->counts[0] && l < VEIL_MAX_LIGHTS; ++l)
+            append(want.defines, cap, " VEIL_LIGHT(%d, %d, %d)", l, (int)mu->lights[l].position[3],
+                   mu->sun_of[l / 4][l % 4] - 1);
+        append(want.defines, cap, "\n", 0, 0, 0);
+        snprintf(name + strlen(name), sizeof name - strlen(name), "%d lights compiled in", mu->counts[0]);
+    }
+    for (int i = 0; i < MARCH_PROGRAMS; ++i)
+        if (m->programs[i].program && strcmp(m->programs[i].defines, want.defines) == 0) {
+            *out = m->programs[i].program;
+            return VEIL_OK;
+        }
+    veil_result r = veil_gpu_program_variant("render/shaders/march.comp", want.defines, name, &want.program, err);
+    if (r != VEIL_OK) return r;
+    march_program* slot = &m->programs[m->next];
+    m->next = (m->next + 1) % MARCH_PROGRAMS;
+    glDeleteProgram(slot->program);
+    *slot = want;
+    *out = want.program;
+    return VEIL_OK;
 }
 
 veil_result veil_march_create(veil_march** out, veil_error* err)
@@ -49,10 +99,7 @@ veil_result veil_march_create(veil_march** out, veil_error* err)
     *out = NULL;
     veil_march* m = calloc(1, sizeof *m);
     if (!m) return veil_fail(err, VEIL_ERR_OOM, "out of memory creating the ray marcher");
-    veil_result r = variant(m, 0, err);
-    if (r == VEIL_OK) r = variant(m, MARCH_EMISSION, err);
-    if (r == VEIL_OK)
-        r = veil_gl_buffer(NULL, sizeof(veil_march_block), GL_DYNAMIC_STORAGE_BIT, "veil march block", &m->ubo, err);
+    veil_result r = veil_gl_buffer(NULL, sizeof(veil_march_block), GL_DYNAMIC_STORAGE_BIT, "veil march block", &m->ubo, err);
     if (r == VEIL_OK)
         r = veil_gl_buffer(NULL, sizeof(veil_medium_block), GL_DYNAMIC_STORAGE_BIT, "veil march medium block",
                            &m->medium_ubo, err);
@@ -67,7 +114,7 @@ veil_result veil_march_create(veil_march** out, veil_error* err)
 void veil_march_destroy(veil_march* m)
 {
     if (!m) return;
-    for (int v = 0; v < MARCH_VARIANTS; ++v) glDeleteProgram(m->program[v]);
+    for (int i = 0; i < MARCH_PROGRAMS; ++i) glDeleteProgram(m->programs[i].program);
     for (int v = 0; v < 4; ++v) glDeleteProgram(m->gather[v]);
     glDeleteBuffers(1, &m->ubo);
     glDeleteBuffers(1, &m->medium_ubo);
@@ -141,11 +188,14 @@ static veil_result image(int w, int h, const char* label, GLuint* tex, veil_erro
     return veil_gl_check(label, err);
 }
 
-static uint64_t g_band_work = VEIL_MARCH_DISPATCH_WORK;
+static uint64_t g_band_work = VEIL_MARCH_DISPATCH_WORK, g_light_list_work = VEIL_MARCH_LIGHT_LIST_WORK;
 
 void veil_march_set_dispatch_work(uint64_t work) { g_band_work = work ? work : VEIL_MARCH_DISPATCH_WORK; }
 
-int veil_march_band_rows(const veil_march_desc* d, int w, int h)
+void veil_march_set_light_list_work(uint64_t work) { g_light_list_work = work ? work : VEIL_MARCH_LIGHT_LIST_WORK; }
+
+/* The work of one row of w pixels: w x steps a ray x (1 + lights) (VEIL_MARCH_DISPATCH_WORK). */
+static double row_work(const veil_march_desc* d, int w)
 {
     double steps = 1.0;
     const veil_lit_medium* lm = &d->medium;
@@ -157,7 +207,12 @@ int veil_march_band_rows(const veil_march_desc* d, int w, int h)
     }
     for (size_t i = 0; i < lm->scene->medium.source_count; ++i)
         if (lm->scene->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL) steps += 64.0;
-    const double per_row = (double)w * steps * (1.0 + lm->light_count);
+    return (double)w * steps * (1.0 + lm->light_count);
+}
+
+int veil_march_band_rows(const veil_march_desc* d, int w, int h)
+{
+    const double per_row = row_work(d, w);
     double rows = floor((double)g_band_work / per_row / VEIL_MARCH_GROUP) * VEIL_MARCH_GROUP;
     if (rows < VEIL_MARCH_GROUP) rows = VEIL_MARCH_GROUP;
     return rows >= h ? h : (int)rows;
@@ -200,11 +255,11 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         glNamedBufferSubData(m->ubo, 0, sizeof u, &u);
         glNamedBufferSubData(m->medium_ubo, 0, sizeof mu, &mu);
     }
-    const int v = (lm->grid && lm->sparse ? MARCH_SPARSE : 0) + (lm->grid && lm->emission ? MARCH_EMISSION : 0) +
-                  (mu.solid_origin[3] > 0.0f ? MARCH_SOLID : 0);
-    if (r == VEIL_OK) r = variant(m, v, err);
+    GLuint program = 0;
+    const int light_list = row_work(d, w) * h >= (double)g_light_list_work;
+    if (r == VEIL_OK) r = program_for(m, lm, &mu, &u, light_list, &program, err);
     if (r == VEIL_OK) {
-        glUseProgram(m->program[v]);
+        glUseProgram(program);
         veil_ev_sparse_bind(lm->grid ? lm->sparse : NULL);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MARCH, m->ubo);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MEDIUM, m->medium_ubo);
@@ -232,7 +287,7 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
                 g->rays = (int)u.march[1], g->scale = sc, g->step = u.march[2], g->ms = veil_now_ms() - t0;
                 memcpy(g->dims, gd, sizeof gd);
                 glBindImageTexture(VEIL_IMAGE_CACHE, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-                glUseProgram(m->program[v]);
+                glUseProgram(program);
             }
         }
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], tex[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);

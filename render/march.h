@@ -35,6 +35,17 @@
  * over the step, plus 64 a fog. */
 #define VEIL_MARCH_DISPATCH_WORK ((uint64_t)1 << 28)
 
+/* A frame whose estimated work (as VEIL_MARCH_DISPATCH_WORK counts it) is at
+ * least this gets a march compiled for its lights (VEIL_LIGHT_LIST: each
+ * one's kind and light-space grid as constants; render/march.c). On
+ * llvmpipe that program marches the demo 1.5x faster than the one that
+ * reads the lights from the medium's block, and costs about 0.5 s to
+ * compile once per light setup (Mesa's shader cache keeps it between runs);
+ * the demo's 3.2e8 units take about 5 s the generic way, so at 2^26 = 6.7e7
+ * units (about 1 s) the saving and the compile are about even. Smaller frames
+ * (tests, previews, the stress test's 500 light setups) keep the generic one. */
+#define VEIL_MARCH_LIGHT_LIST_WORK ((uint64_t)1 << 26)
+
 typedef struct veil_march veil_march;
 
 /* The phase function's g from which the default gathers the cache's later light (render/shaders/
@@ -86,6 +97,10 @@ int veil_march_band_rows(const veil_march_desc* d, int w, int h);
 
 /* Tests: the work budget of a band (0: VEIL_MARCH_DISPATCH_WORK again). */
 void veil_march_set_dispatch_work(uint64_t work);
+
+/* Tests: the work from which a frame's march is compiled for its lights (0: VEIL_MARCH_LIGHT_LIST_WORK
+ * again; UINT64_MAX: never). */
+void veil_march_set_light_list_work(uint64_t work);
 
 
 #endif

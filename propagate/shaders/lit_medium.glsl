@@ -42,8 +42,13 @@ float fog_integral(vec3 p, vec3 d, float t0, float t1)
 
 // The EV's density integral from x to the light along unit direction `to`
 // over length `len` (INF for a sun): the optical-depth volume at x, or at
-// the point where that path enters the EV's box.
-float ev_depth(int l, vec3 x, vec3 to, float len)
+// the point where that path enters the EV's box. With `grid` true, from
+// light-space grid k (light l's: med.sun_of), else from light l's channel of
+// the OPVs. A caller that knows `grid` when the shader is compiled passes a
+// constant (the march's two light loops): llvmpipe runs both sides of a
+// branch it cannot fold, and the grid's side cost the march 1.35x in every
+// light's lookup (docs/performance.md).
+float ev_depth_in(int l, bool grid, int k, vec3 x, vec3 to, float len)
 {
     if (med.counts.z == 0) return 0.0;
 #ifdef VEIL_SPARSE
@@ -59,8 +64,7 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
     vec2 s = box_hit(x, to, med.box_min.xyz, med.box_max.xyz, 0.0, len);
     if (s.x > s.y) return 0.0;
     vec3 y = x + to * s.x; // where the path enters the box; s.y - s.x of it lies inside
-    int k = med.sun_of[l / 4][l % 4] - 1;
-    if (k >= 0) { // a sun in its light-space grid (propagate/sun_space.h)
+    if (grid) { // a sun in its light-space grid (propagate/sun_space.h)
         // D on the node plane just towards the light (bilinear within the
         // plane, none between planes) plus the density over the stretch
         // back to y, midpoint rule in sun_step.z pieces of at most a voxel:
@@ -84,6 +88,17 @@ float ev_depth(int l, vec3 x, vec3 to, float len)
     return texture(u_opv[l / 4], (y - med.tex_min.xyz) * med.tex_inv_size.xyz)[l % 4];
 #endif
 }
+
+// The light-space grid holding light l, -1 for none (med.sun_of).
+int sun_of(int l) { return med.sun_of[l / 4][l % 4] - 1; }
+
+// The lights read from the OPVs (med.on_opv, med.counts.w of them) and those
+// from light-space grids (med.counts.x - med.counts.w: grid k holds light
+// med.sun_step[k].w), for loops that take each kind apart.
+int opv_lights() { return med.counts.w; }
+int opv_light(int i) { return med.on_opv[i / 4][i % 4]; }
+int grid_suns() { return med.counts.x - med.counts.w; }
+int grid_sun_light(int k) { return int(med.sun_step[k].w); }
 
 #ifdef VEIL_SOLID
 // The surfaces of a frame under `veil fog` (scene/solid.h): solid voxels,
@@ -154,16 +169,18 @@ float solid_hit(vec3 p, vec3 d, float t_max)
 // E (W/m^2: I / r^2 for point and spot lights, with the cone; a sun's own;
 // less what a frame's surfaces shadow) and the distance to it (INF for a
 // sun). False when it adds nothing here.
-bool light_at(int l, vec3 x, out vec3 travel, out vec3 E, out float len)
+// `kind` is light l's (med.lights[l].position.w), a constant where the caller
+// knows it (as `grid` in ev_depth_in).
+bool light_at_kind(int l, int kind, vec3 x, out vec3 travel, out vec3 E, out float len)
 {
-    if (int(med.lights[l].position.w) != VEIL_LIGHT_DIRECTIONAL) {
+    if (kind != VEIL_LIGHT_DIRECTIONAL) {
         vec3 to_light = med.lights[l].position.xyz - x;
         float r2 = max(dot(to_light, to_light),
-                       int(med.lights[l].position.w) == VEIL_LIGHT_POINT ? max(med.shape.x, med.lights[l].direction.w) : med.shape.x);
+                       kind == VEIL_LIGHT_POINT ? max(med.shape.x, med.lights[l].direction.w) : med.shape.x);
         len = sqrt(r2);
         travel = -to_light / len;
         E = med.lights[l].color.rgb / r2;
-        if (int(med.lights[l].position.w) == VEIL_LIGHT_SPOT)
+        if (kind == VEIL_LIGHT_SPOT)
             E *= veil_spot_falloff(dot(travel, med.lights[l].direction.xyz), med.lights[l].direction.w, med.lights[l].color.w);
     } else {
         travel = med.lights[l].direction.xyz;
@@ -176,10 +193,22 @@ bool light_at(int l, vec3 x, out vec3 travel, out vec3 E, out float len)
     return max(E.r, max(E.g, E.b)) > 0.0;
 }
 
+bool light_at(int l, vec3 x, out vec3 travel, out vec3 E, out float len)
+{
+    return light_at_kind(l, int(med.lights[l].position.w), x, travel, E, len);
+}
+
 // The density integral from x to light l (EV and fogs). A fog's closed form
 // overflows to +inf for rho0 e^60 len > 3.4e38: kept finite so that a channel
 // with sigma_t = 0 gets exp(0) = 1, not exp(0 * inf) = NaN.
+// `grid` and k as in ev_depth_in.
+float depth_to_light_in(int l, bool grid, int k, vec3 x, vec3 travel, float len)
+{
+    return min(ev_depth_in(l, grid, k, x, -travel, len) + fog_integral(x, -travel, 0.0, len), INF);
+}
+
 float depth_to_light(int l, vec3 x, vec3 travel, float len)
 {
-    return min(ev_depth(l, x, -travel, len) + fog_integral(x, -travel, 0.0, len), INF);
+    int k = sun_of(l);
+    return depth_to_light_in(l, k >= 0, k, x, travel, len);
 }

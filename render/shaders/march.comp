@@ -50,6 +50,24 @@
 // the march ends at the first step boundary at or beyond it (the same steps);
 // with u.flags.w each pixel's ray ends exactly at the distance in u_limit (a
 // surface of a frame rendered elsewhere: `veil fog`).
+// Compiled in for a large frame (render/march.c: the march's programs),
+// since llvmpipe runs both sides of every branch it cannot fold, texture
+// reads included: the lights (VEIL_LIGHT_LIST: each one's kind and
+// light-space grid), which field u_phi holds (VEIL_MARCH_FIELD, a
+// VEIL_FIELD_*, as u.diffusion.w) and whether the cache's later light is
+// gathered (VEIL_MARCH_GATHER, as u.march.y > 0). The generic program reads
+// all three from the blocks. (The field compiled into the generic light loop
+// came out wrong on llvmpipe of Mesa 22.3: the cache's light 8x too dark on
+// fog_lights, single scattering exact; the two are compiled in together.)
+#ifdef VEIL_MARCH_FIELD
+#define MARCH_FIELD_IS(kind) (VEIL_MARCH_FIELD == (kind))
+#define MARCH_GATHER (VEIL_MARCH_GATHER != 0)
+#define MARCH_CACHE_ONLY (VEIL_MARCH_FIELD == VEIL_FIELD_CACHE) /* no escape field, no octaves */
+#else
+#define MARCH_FIELD_IS(kind) (u.diffusion.w == float(kind))
+#define MARCH_GATHER (u.march.y > 0.0)
+#define MARCH_CACHE_ONLY 0
+#endif
 layout(local_size_x = VEIL_MARCH_GROUP, local_size_y = VEIL_MARCH_GROUP) in;
 
 layout(binding = VEIL_IMAGE_OUT, rgba32f) writeonly uniform image2D u_out;     // rgb radiance, a = 1 - mean T
@@ -72,6 +90,38 @@ uint hash32(uint x)
     return x;
 }
 
+// Light l's part of in_scattered at x: its single scattering added to
+// `sum`, its octaves to `multi`. `kind`, `grid` and k as light_at_kind and
+// ev_depth_in take them.
+void light_in(int l, int kind, bool grid, int k, vec3 x, vec3 dir, float p_cam, int octaves, vec3 albedo, vec3 floor_t,
+              bool use_escape, float escape, inout vec3 sum, inout vec3 multi)
+{
+    vec3 travel, E;
+    float len;
+    if (!light_at_kind(l, kind, x, travel, E, len)) return;
+    float D = depth_to_light_in(l, grid, k, x, travel, len);
+    float cos_theta = clamp(dot(travel, -dir), -1.0, 1.0);
+    sum += E * exp(-med.sigma_t.rgb * D) * veil_phase_hg(cos_theta, med.shape.z);
+    // the chance that light on the two legs through x (from the light,
+    // to the camera) scattered again: no medium around x, no higher orders
+    // (D + p_cam kept finite: 0 * inf would be NaN where sigma_s = 0)
+    // or, with the escape field, the chance averaged over all directions
+    // (without a field, e.g. a fog box too large for a grid, the legs serve)
+    float gate = use_escape ? escape
+               : 1.0 - exp(-dot(med.sigma_s.rgb, vec3(1.0 / 3.0)) * min(D + p_cam, INF));
+    // the legs' gate counts once; the escape field's chance is paid per further scattering
+#if !MARCH_CACHE_ONLY /* with a cache, never the octaves (render/march.c) */
+    float a = 1.0, g = med.shape.z, per = use_escape ? gate : 1.0;
+    vec3 b = vec3(use_escape ? 1.0 : gate);
+    for (int i = 1; i < octaves; ++i) {
+        a *= u.octave.x, g *= u.octave.z;
+        b *= u.octave.y * per * albedo;
+        vec3 att = exp(-max(a * med.sigma_t.rgb, floor_t) * D);
+        multi += b * E * att * veil_phase_hg(cos_theta, g);
+    }
+#endif
+}
+
 // Light scattered towards -dir at x: single scattering returned, the
 // octaves' estimate of the higher orders in `multi`.
 vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
@@ -86,8 +136,9 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
     // an octave's reduced extinction a^i sigma_t never goes below that
     vec3 sigma_a = max(med.sigma_t.rgb - med.sigma_s.rgb, 0.0);
     vec3 floor_t = sqrt(3.0 * sigma_a * (sigma_a + med.sigma_s.rgb * (1.0 - med.shape.z)));
-    bool use_escape = u.diffusion.w == float(VEIL_FIELD_ESCAPE);
+    bool use_escape = MARCH_FIELD_IS(VEIL_FIELD_ESCAPE);
     float escape = 0.0;
+#if !MARCH_CACHE_ONLY
     if (use_escape) {
 #ifdef VEIL_SPARSE
         // the field lives in the kept bricks; elsewhere (fog) the legs serve
@@ -101,33 +152,27 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
         escape = texture(u_phi, (x - u.diffusion.xyz) * u.diffusion_inv.xyz).r;
 #endif
     }
-    for (int l = 0; l < med.counts.x; ++l) {
-        vec3 travel, E;
-        float len;
-        if (!light_at(l, x, travel, E, len)) continue;
-        float D = depth_to_light(l, x, travel, len);
-        float cos_theta = clamp(dot(travel, -dir), -1.0, 1.0);
-        sum += E * exp(-med.sigma_t.rgb * D) * veil_phase_hg(cos_theta, med.shape.z);
-        // the chance that light on the two legs through x (from the light,
-        // to the camera) scattered again: no medium around x, no higher orders
-        // (D + p_cam kept finite: 0 * inf would be NaN where sigma_s = 0)
-        // or, with the escape field, the chance averaged over all directions
-        // (without a field, e.g. a fog box too large for a grid, the legs serve)
-        float gate = use_escape ? escape
-                   : 1.0 - exp(-dot(med.sigma_s.rgb, vec3(1.0 / 3.0)) * min(D + p_cam, INF));
-        // the legs' gate counts once; the escape field's chance is paid per further scattering
-        float a = 1.0, g = med.shape.z, per = use_escape ? gate : 1.0;
-        vec3 b = vec3(use_escape ? 1.0 : gate);
-        for (int i = 1; i < octaves; ++i) {
-            a *= u.octave.x, g *= u.octave.z;
-            b *= u.octave.y * per * albedo;
-            vec3 att = exp(-max(a * med.sigma_t.rgb, floor_t) * D);
-            multi += b * E * att * veil_phase_hg(cos_theta, g);
-        }
+#endif
+#ifdef VEIL_LIGHT_LIST
+    // each light with its kind and grid as constants (render/march.c)
+#define VEIL_LIGHT(l, kind, k) \
+    light_in(l, kind, (k) >= 0, max(k, 0), x, dir, p_cam, octaves, albedo, floor_t, use_escape, escape, sum, multi);
+    VEIL_LIGHT_LIST
+#undef VEIL_LIGHT
+#else
+    // the lights read from the OPVs, then the suns in light-space grids: two
+    // loops, so that neither runs the other's lookup (ev_depth_in)
+    for (int i = 0; i < opv_lights(); ++i) {
+        int l = opv_light(i);
+        light_in(l, int(med.lights[l].position.w), false, 0, x, dir, p_cam, octaves, albedo, floor_t, use_escape, escape, sum, multi);
     }
+    for (int k = 0; k < grid_suns(); ++k)
+        light_in(grid_sun_light(k), VEIL_LIGHT_DIRECTIONAL, true, k, x, dir, p_cam, octaves, albedo, floor_t, use_escape, escape,
+                 sum, multi);
+#endif
     // the diffusion estimate: the fluence of light scattered at least once,
     // scattered again, isotropically, towards the camera
-    if (u.diffusion.w == float(VEIL_FIELD_FLUENCE))
+    if (MARCH_FIELD_IS(VEIL_FIELD_FLUENCE))
         multi += texture(u_phi, (x - u.diffusion.xyz) * u.diffusion_inv.xyz).rgb * (1.0 / (4.0 * VEIL_PI));
     return sum;
 }
@@ -154,9 +199,9 @@ void main()
     // the light cache's forward peak f (cache_in: g^2 of the phase function; 0 for g <= 0, and without a
     // cache, where T_red is T) and the transmittance of the reduced extinction sigma_t - f sigma_s that
     // carries the later light along the ray: the march goes on until it, not T, is negligible
-    bool cache = u.diffusion.w == float(VEIL_FIELD_CACHE);
+    bool cache = MARCH_FIELD_IS(VEIL_FIELD_CACHE);
     // (with the gather, u.march.y > 0, the later light towards the camera is gathered: no peak carried)
-    bool gather = cache && u.march.y > 0.0;
+    bool gather = cache && MARCH_GATHER;
     float f_peak = cache && !gather ? max(med.shape.z, 0.0) * max(med.shape.z, 0.0) : 0.0;
     vec3 T_red = vec3(1.0);
     float q_p = 0.0, q_w = 0.0;        // luminance-weighted P of Q
