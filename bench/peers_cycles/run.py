@@ -142,8 +142,8 @@ def write(a, rows, w, h):
         cw.writerows(rows)
     cyc = [r for r in rows if r["tool"] == "cycles"]
     lines = ["The shared smoke at %dx%d, all orders, against `veil reference` at %d spp: `/usr/bin/python3 "
-             "bench/peers_cycles/run.py --size %dx%d --spp-list %s --runs %d` (%s). Errors are relative RMSE "
-             "with the reference's noise taken out." % (w, h, a.ref_spp, w, h, a.spp_list, a.runs,
+             "bench/peers_cycles/run.py --size %dx%d --spp-list %s --runs %d --ref-spp %d` (%s). Errors are relative "
+             "RMSE with the reference's noise taken out." % (w, h, a.ref_spp, w, h, a.spp_list, a.runs, a.ref_spp,
                                                           time.strftime("%Y-%m-%d")), "",
              "| tool | setting | wall (s) | Cycles' own (s) | error, pixel | error, 4x4 | bias | Cycles at equal "
              "error, pixel | 4x4 |", "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
