@@ -119,11 +119,10 @@ def box(name, lo, hi, material):
     return ob
 
 
-def fog_material(c):
-    """The fog of case dict c (g, sigma_s, sigma_a grey; fog: density, falloff b): Volume Scatter plus
-    Volume Absorption, rho = density exp(-b y) from the world position (constant: Cycles' homogeneous
-    path)."""
-    m = bpy.data.materials.new("fog")
+def grey_medium(name, g):
+    """A material whose volume is Volume Scatter (white, HG g) plus Volume Absorption (black):
+    (material, its node tree, the scatter node, the absorption node), their Density left to the caller."""
+    m = bpy.data.materials.new(name)
     m.use_nodes = True
     nt = m.node_tree
     nt.nodes.clear()
@@ -132,8 +131,19 @@ def fog_material(c):
     absb = nt.nodes.new("ShaderNodeVolumeAbsorption")
     add = nt.nodes.new("ShaderNodeAddShader")
     scat.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-    scat.inputs["Anisotropy"].default_value = c["g"]
+    scat.inputs["Anisotropy"].default_value = g
     absb.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    nt.links.new(scat.outputs[0], add.inputs[0])
+    nt.links.new(absb.outputs[0], add.inputs[1])
+    nt.links.new(add.outputs[0], out.inputs["Volume"])
+    return m, nt, scat, absb
+
+
+def fog_material(c):
+    """The fog of case dict c (g, sigma_s, sigma_a grey; fog: density, falloff b): Volume Scatter plus
+    Volume Absorption, rho = density exp(-b y) from the world position (constant: Cycles' homogeneous
+    path)."""
+    m, nt, scat, absb = grey_medium("fog", c["g"])
     ss, sa = c["sigma_s"][0], c["sigma_a"][0]
     assert c["sigma_s"] == [ss] * 3 and c["sigma_a"] == [sa] * 3, "grey media only"
     rho0, b = c["fog"]["density"], c["fog"]["falloff"]
@@ -165,7 +175,4 @@ def fog_material(c):
         # times this rate (and the scene's rate): 0.1 * 87 m * 0.06 = 0.52 m (b dt = 0.1: the jittered
         # march's optical depth has a variance far below the noise)
         m.cycles.volume_step_rate = 0.06
-    nt.links.new(scat.outputs[0], add.inputs[0])
-    nt.links.new(absb.outputs[0], add.inputs[1])
-    nt.links.new(add.outputs[0], out.inputs["Volume"])
     return m

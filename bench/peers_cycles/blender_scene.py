@@ -53,16 +53,9 @@ def main():
     ob.data.render.precision = "FULL"
     ob.data.render.space = "OBJECT"
     ob.data.render.step_size = 0.0  # the grid's own voxel
-    m = bpy.data.materials.new("medium")
-    m.use_nodes = True
-    nt = m.node_tree
-    nt.nodes.clear()
-    out_node = nt.nodes.new("ShaderNodeOutputMaterial")
+    m, nt, scat, absb = bs.grey_medium("medium", med["phase"]["g"])
     attr = nt.nodes.new("ShaderNodeAttribute")
     attr.attribute_name = attr_grid(src)
-    scat = nt.nodes.new("ShaderNodeVolumeScatter")
-    absb = nt.nodes.new("ShaderNodeVolumeAbsorption")
-    add = nt.nodes.new("ShaderNodeAddShader")
     scale = src.get("density_scale", 1.0)
     for k, node in ((ss * scale, scat), (sa * scale, absb)):
         mul = nt.nodes.new("ShaderNodeMath")
@@ -70,12 +63,6 @@ def main():
         mul.inputs[1].default_value = k
         nt.links.new(attr.outputs["Fac"], mul.inputs[0])
         nt.links.new(mul.outputs[0], node.inputs["Density"])
-    scat.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-    scat.inputs["Anisotropy"].default_value = med["phase"]["g"]
-    absb.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-    nt.links.new(scat.outputs[0], add.inputs[0])
-    nt.links.new(absb.outputs[0], add.inputs[1])
-    nt.links.new(add.outputs[0], out_node.inputs["Volume"])
     ob.data.materials.append(m)
     bs.unbiased(sc, s["camera"]["width"], s["camera"]["height"], int(spp), int(seed), 256, out)
     sc.cycles.volume_step_rate = 1.0
