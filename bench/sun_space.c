@@ -1,11 +1,12 @@
-/* veil — a sun's optical depth: the light-space prefix sum
- * (propagate/sun_space.h) against the semi-Lagrangian pass on the EV's
- * grid, run time against error.
+/* veil — a light's optical depth: the light-space prefix sum
+ * (propagate/sun_space.h; for point lights its perspective form) against
+ * the semi-Lagrangian pass on the EV's grid, run time against error.
  *
- *   sun_space [--sizes 64,128] [--media smoke,smoke-vdb,...] [--runs N]
+ *   sun_space [--sizes 64,128] [--media smoke,smoke-vdb,...] [--runs N] [--suns | --points]
  *
- * For each medium of bench/media.h on an N^3 grid and one sun (the
- * directional light of bench/propagation.c, and a second, steeper one),
+ * For each medium of bench/media.h on an N^3 grid and each light (the
+ * directional light of bench/propagation.c and a second, steeper one; its
+ * two point lights, inside the box and outside it),
  * each configuration fills its optical depth on the GPU; the time is the
  * median over --runs of the whole call, upload and read-back included
  * (both methods pay the same upload; the read-back of the light-space grid
@@ -15,7 +16,10 @@
  * anywhere, not only at voxel centres), each grid read as the march reads
  * it, in double here: the semi-Lagrangian volume trilinearly; the
  * light-space grid bilinearly on the node plane towards the light plus the
- * density over the stretch back (lit_medium.glsl). Same metrics as
+ * density over the stretch back (lit_medium.glsl; a point light's through
+ * veil_point_space_depth, the shader's C twin, in float). The read-back is
+ * timed too: a point light's grid holds more nodes than the EV has voxels,
+ * so in-frame stage times (docs/performance.md) are its fairer cost. Same metrics as
  * bench/propagation.c: sigma_t = 4 / (box width * max density), rms of the
  * relative error of D where tau_ref >= 0.05, max |exp(-tau) - exp(-tau_ref)|.
  * Exit status: 0, 77 when no GL 4.5 context can be made, 1 on errors. */
@@ -43,17 +47,27 @@ typedef struct config {
     int light_space; /* 0: semi-Lagrangian on the grid */
     float across, along;
     int panels;
+    int points;      /* 1: for point lights (the perspective grid), 0: for suns, -1: both */
+    int pieces;      /* point lights: the stretch back's pieces, 0: veil_point_space_pieces */
 } config;
 
 static const config configs[] = {
-    {"semi-lagrangian", 0, 0, 0, 0},
-    {"light-space 1/1", 1, 1.0f, 1.0f, 1},
-    {"light-space 1/1, 2 panels", 1, 1.0f, 1.0f, 2},
-    {"light-space 1/4", 1, 1.0f, 4.0f, 1},
-    {"light-space 0.7/4", 1, 0.7f, 4.0f, 1},
-    {"light-space 0.5/1", 1, 0.5f, 1.0f, 1},
-    {"light-space 0.5/4", 1, 0.5f, 4.0f, 1},
-    {"light-space 0.35/4", 1, 0.35f, 4.0f, 1},
+    {"semi-lagrangian", 0, 0, 0, 0, -1, 0},
+    {"perspective 1.4/2 (draft)", 1, 1.4f, 2.0f, 1, 1, 0},
+    {"perspective 0.7/2 (default)", 1, 0.7f, 2.0f, 1, 1, 0},
+    {"perspective 0.7/2, 1 piece", 1, 0.7f, 2.0f, 1, 1, 1},
+    {"perspective 0.7/2, pieces <= 1 voxel", 1, 0.7f, 2.0f, 1, 1, 4},
+    {"perspective 0.7/4", 1, 0.7f, 4.0f, 1, 1, 0},
+    {"perspective 0.5/2", 1, 0.5f, 2.0f, 1, 1, 0},
+    {"perspective 0.49/2 (high)", 1, 0.49f, 2.0f, 1, 1, 0},
+    {"perspective 0.35/2", 1, 0.35f, 2.0f, 1, 1, 0},
+    {"light-space 1/1", 1, 1.0f, 1.0f, 1, 0, 0},
+    {"light-space 1/1, 2 panels", 1, 1.0f, 1.0f, 2, 0, 0},
+    {"light-space 1/4", 1, 1.0f, 4.0f, 1, 0, 0},
+    {"light-space 0.7/4", 1, 0.7f, 4.0f, 1, 0, 0},
+    {"light-space 0.5/1", 1, 0.5f, 1.0f, 1, 0, 0},
+    {"light-space 0.5/4", 1, 0.5f, 4.0f, 1, 0, 0},
+    {"light-space 0.35/4", 1, 0.35f, 4.0f, 1, 0, 0},
 };
 #define CONFIGS (int)(sizeof configs / sizeof configs[0])
 
@@ -107,6 +121,30 @@ static double lookup(const veil_grid* g, const float* rho, const veil_sun_space*
     return sum;
 }
 
+/* D at world x (in the box) from a point light's perspective grid, as the
+ * march reads it: veil_point_space_depth (the shader's C twin), the
+ * stretch back clipped to the path's part in the box (to the light, or to
+ * where the path leaves the box). */
+static double lookup_point(const veil_grid* g, const float* rho, const veil_sun_space* s, const float* D,
+                           const double x[3], const float light[3], int pieces)
+{
+    float blo[3], bhi[3], y[3];
+    veil_grid_medium_box(g, blo, bhi);
+    double to[3], dist = 0.0;
+    for (int a = 0; a < 3; ++a) to[a] = light[a] - x[a], dist += to[a] * to[a];
+    dist = sqrt(dist);
+    double room = dist;
+    for (int a = 0; a < 3; ++a) {
+        to[a] /= dist;
+        y[a] = (float)((x[a] - g->origin[a]) / g->voxel - 0.5);
+        if (to[a] != 0.0) {
+            double exit = ((to[a] > 0 ? bhi[a] : blo[a]) - x[a]) / to[a];
+            room = exit < room ? (exit > 0 ? exit : 0) : room;
+        }
+    }
+    return veil_point_space_depth(g, rho, s, D, y, (float)room, pieces > 0 ? pieces : veil_point_space_pieces(s));
+}
+
 /* Trilinear lookup of an OPV on the EV's grid at world x (clamped like the texture). */
 static double lookup_grid(const veil_grid* g, const float* D, const double x[3])
 {
@@ -137,12 +175,16 @@ static int cmp_double(const void* a, const void* b)
 
 int main(int argc, char** argv)
 {
-    int sizes[8] = {64, 128}, n_sizes = 2, runs = 3;
+    int sizes[8] = {64, 128}, n_sizes = 2, runs = 3, only_suns = 0, only_points = 0;
     int use[MEDIUM_COUNT] = {1, 1, 1, 1};
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--sizes") && i + 1 < argc) {
             n_sizes = 0;
             for (char* t = strtok(argv[++i], ","); t && n_sizes < 8; t = strtok(NULL, ",")) sizes[n_sizes++] = atoi(t);
+        } else if (!strcmp(argv[i], "--suns")) {
+            only_suns = 1;
+        } else if (!strcmp(argv[i], "--points")) {
+            only_points = 1;
         } else if (!strcmp(argv[i], "--runs") && i + 1 < argc) {
             runs = atoi(argv[++i]);
         } else if (!strcmp(argv[i], "--media") && i + 1 < argc) {
@@ -151,7 +193,7 @@ int main(int argc, char** argv)
                 for (int m = 0; m < MEDIUM_COUNT; ++m)
                     if (!strcmp(t, medium_names[m])) use[m] = 1;
         } else {
-            fprintf(stderr, "usage: sun_space [--sizes 64,128] [--media a,b] [--runs N]\n");
+            fprintf(stderr, "usage: sun_space [--sizes 64,128] [--media a,b] [--runs N] [--suns | --points]\n");
             return 2;
         }
     }
@@ -171,7 +213,10 @@ int main(int argc, char** argv)
     GLint max_axis = 0;
     glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max_axis);
     const float suns[2][3] = {{-0.5f, -0.6f, -0.62f}, {0.3f, -1.0f, 0.2f}};
-    printf("| medium | grid | sun | method | nodes (M) | time (ms) | rms rel. error of D | max |Δ exp(−τ)| |\n");
+    /* bench/propagation.c's point lights: inside the box, and outside it */
+    const float points[2][3] = {{0.0637f, 0.1437f, -0.0533f}, {-2.83f, 1.61f, 1.17f}};
+    const char* const light_names[4] = {"sun 0", "sun 1", "point in", "point out"};
+    printf("| medium | grid | light | method | nodes (M) | time (ms) | rms rel. error of D | max |Δ exp(−τ)| |\n");
     printf("|---|---|---|---|---:|---:|---:|---:|\n");
     int status = 0;
     for (int si = 0; si < n_sizes && status == 0; ++si)
@@ -193,10 +238,16 @@ int main(int argc, char** argv)
             veil_grid_medium_box(&g, lo, hi);
             double* dref = malloc(SAMPLES * sizeof *dref);
             float* grid_d = malloc(nv * sizeof *grid_d);
-            for (int sun = 0; sun < 2 && status == 0; ++sun) {
-                veil_light l = {.type = VEIL_LIGHT_DIRECTIONAL};
-                double len = sqrt(suns[sun][0] * suns[sun][0] + suns[sun][1] * suns[sun][1] + suns[sun][2] * suns[sun][2]);
-                for (int a = 0; a < 3; ++a) l.direction[a] = (float)(suns[sun][a] / len);
+            for (int li = only_points ? 2 : 0; li < (only_suns ? 2 : 4) && status == 0; ++li) {
+                const int point = li >= 2;
+                veil_light l = {.type = point ? VEIL_LIGHT_POINT : VEIL_LIGHT_DIRECTIONAL, .color = {1, 1, 1}};
+                if (point) {
+                    for (int a = 0; a < 3; ++a) l.position[a] = points[li - 2][a];
+                } else {
+                    const float* d = suns[li];
+                    double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                    for (int a = 0; a < 3; ++a) l.direction[a] = (float)(d[a] / len);
+                }
                 for (int s = 0; s < SAMPLES; ++s) {
                     for (int a = 0; a < 3; ++a) samples[s][a] = lo[a] + (hi[a] - lo[a]) * veil_rng_double53(&rng);
                     dref[s] = veil_ref_optical_depth(&g, rho, &l, samples[s], 1.0);
@@ -205,11 +256,16 @@ int main(int argc, char** argv)
                 veil_light_to_index(&l, g.dims, g.origin, g.voxel, &ol);
                 for (int c = 0; c < CONFIGS && status == 0; ++c) {
                     const config* cf = &configs[c];
+                    if (cf->points >= 0 && cf->points != point) continue;
                     veil_sun_space sp;
                     float* D = grid_d;
                     if (cf->light_space) {
-                        if (veil_sun_space_make(&g, l.direction, cf->across, cf->along, cf->panels, max_axis, VEIL_SUN_MAX_NODES, &sp, &err) !=
-                            VEIL_OK) {
+                        veil_result made =
+                            point ? veil_point_space_make(&g, ol.v, cf->across, cf->along, cf->panels, max_axis,
+                                                          VEIL_SUN_MAX_NODES, &sp, &err)
+                                  : veil_sun_space_make(&g, l.direction, cf->across, cf->along, cf->panels, max_axis,
+                                                        VEIL_SUN_MAX_NODES, &sp, &err);
+                        if (made != VEIL_OK) {
                             fprintf(stderr, "sun_space: %s\n", err.msg);
                             continue;
                         }
@@ -235,8 +291,9 @@ int main(int argc, char** argv)
                     double sum2 = 0.0, max_t = 0.0;
                     size_t counted = 0;
                     for (int s = 0; s < SAMPLES; ++s) {
-                        double d = cf->light_space ? lookup(&g, rho, &sp, D, samples[s], l.direction)
-                                                   : lookup_grid(&g, D, samples[s]);
+                        double d = !cf->light_space ? lookup_grid(&g, D, samples[s])
+                                   : point ? lookup_point(&g, rho, &sp, D, samples[s], l.position, cf->pieces)
+                                           : lookup(&g, rho, &sp, D, samples[s], l.direction);
                         double dt = fabs(exp(-sigma_t * d) - exp(-sigma_t * dref[s]));
                         max_t = dt > max_t ? dt : max_t;
                         if (sigma_t * dref[s] >= TAU_FLOOR) {
@@ -245,7 +302,7 @@ int main(int argc, char** argv)
                             ++counted;
                         }
                     }
-                    printf("| %s | %d³ | %d | %s | %.2f | %.0f | %.3f %% | %.1e |\n", medium_names[med], sizes[si], sun,
+                    printf("| %s | %d³ | %s | %s | %.2f | %.0f | %.3f %% | %.1e |\n", medium_names[med], sizes[si], light_names[li],
                            cf->name, cf->light_space ? veil_sun_space_nodes(&sp) / 1e6 : nv / 1e6, times[runs / 2],
                            counted ? 100.0 * sqrt(sum2 / counted) : NAN, max_t);
                     fflush(stdout);

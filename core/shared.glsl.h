@@ -115,8 +115,9 @@
 #define VEIL_TEX_LIMIT 6        /* texture unit: r32f per-pixel distance where the ray ends (veil fog) */
 #define VEIL_TEX_DIFFUSION 7    /* texture unit: rgba32f multiply scattered fluence (volumetric/volumetric.h) */
 #define VEIL_TEX_EMISSION 8     /* texture unit: rgba32f emission eps (W m^-3 sr^-1) on the EV's grid */
-/* Texture units 9..12: r32f optical depth of up to VEIL_MAX_SUNS suns in
- * their light-space grids (propagate/sun_space.h). Only over a dense EV,
+/* Texture units 9..12: r32f optical depth of up to VEIL_MAX_SUNS lights in
+ * their light-space grids (propagate/sun_space.h: suns', and point and
+ * spot lights' in the perspective form). Only over a dense EV,
  * so they share units with the sparse tables (9..13), never bound then. */
 #define VEIL_MAX_SUNS 4
 #define VEIL_TEX_SUN0 9
@@ -171,6 +172,11 @@ VEIL_STRUCT_BEGIN(veil_medium_block)
     VEIL_V4(shadow[3 * VEIL_MAX_LIGHTS]);  /* light l: 3l, 3l+1: a sun's map coordinates dot(x, xyz) + w;
                                               3l+2: x: bias (m), y: bias per m along the light's path */
     VEIL_IV4(on_opv[VEIL_MAX_LIGHTS / 4]); /* [i / 4][i % 4], i < counts.w: the lights read from the OPVs, in order */
+    /* A point or spot light's grid k (the perspective form of propagate/sun_space.h; sun_map[3k] then holds
+       the texture's nodes along a, b, c and the planes' spacing in depth (voxels), sun_step[k].xy are 0): */
+    VEIL_V4(sun_light[VEIL_MAX_SUNS]);     /* xyz: the light (m); w: 1 for a perspective grid, 0 for a sun's */
+    VEIL_V4(sun_face[12 * VEIL_MAX_SUNS]); /* face f of grid k: [12k + 2f]: u0, v0, du, z0 (voxels);
+                                              [12k + 2f + 1]: its first plane, columns along u and v, planes */
 VEIL_STRUCT_END(veil_medium_block)
 
 /* What the ray marcher (render/shaders/march.comp) reads besides the

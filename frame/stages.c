@@ -283,11 +283,13 @@ static veil_stage_status propagate_decide(const veil_frame_plan* p, int kept, ch
                                     (unsigned long long)veil_opv_texture_key(p->ev_key, &p->opv, ol + 4 * tex, count));
     }
     for (int q = 0; q < n_suns && len < n; ++q) {
-        const float* a = suns[q].space.axis[0];
-        len += (size_t)snprintf(w + len, n - len, "%s light %d in a light-space grid of %dx%dx%d nodes %.3g voxels "
+        int faces = 0;
+        for (int f = 0; f < 6; ++f) faces += suns[q].space.face[f].nz > 0;
+        char shape[32] = "";
+        if (suns[q].space.perspective) snprintf(shape, sizeof shape, " (%d faces around it)", faces);
+        len += (size_t)snprintf(w + len, n - len, "%s light %d in a light-space grid of %dx%dx%d nodes%s %.3g voxels "
                                 "apart across, key %016llx", q ? "," : ";", suns[q].light, suns[q].space.nodes[0],
-                                suns[q].space.nodes[1], suns[q].space.nodes[2],
-                                sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]),
+                                suns[q].space.nodes[1], suns[q].space.nodes[2], shape, (double)suns[q].space.across,
                                 (unsigned long long)sun_keys[q]);
     }
     return VEIL_STAGE_RAN;
@@ -308,13 +310,15 @@ static veil_result propagate_build(veil_frame* f, veil_stage_report* rep, veil_e
     r->opv_textures = orep.computed + orep.cached;
     st->opv_computed = orep.computed;
     st->opv_cached = orep.cached;
+    st->grids = orep.suns;
+    st->grids_computed = orep.suns_computed;
     st->propagate_iterations = orep.iterations;
     rep->status = orep.computed || orep.suns_computed ? VEIL_STAGE_RAN : VEIL_STAGE_CACHED;
     char from[64] = "";
     if (p->emission_lights) snprintf(from, sizeof from, " (+%d from the emission)", p->emission_lights);
     char suns[128] = "";
     if (orep.suns)
-        snprintf(suns, sizeof suns, "; %d sun%s in light-space grids (%d computed), %.3g voxels apart across",
+        snprintf(suns, sizeof suns, "; %d light%s in light-space grids (%d computed), %.3g voxels apart across",
                  orep.suns, orep.suns > 1 ? "s" : "", orep.suns_computed, orep.sun_across);
     if (rep->status == VEIL_STAGE_RAN)
         say(rep->why, sizeof rep->why, "%d of %zu lights%s, %s, %d passes; %d textures computed (volume or light moved), %d cached%s; "
@@ -328,8 +332,10 @@ static veil_result propagate_build(veil_frame* f, veil_stage_report* rep, veil_e
 
 static void propagate_settle(veil_frame* f, const veil_stage_report* rep)
 {
-    if (f->parts && rep->status == VEIL_STAGE_CACHED && f->st->opv_computed == 0 && f->st->opv_cached == 0)
-        f->st->opv_cached = f->parts->opv_textures; /* decided: every texture is the kept one */
+    if (f->parts && rep->status == VEIL_STAGE_CACHED && f->st->opv_computed == 0 && f->st->opv_cached == 0) {
+        f->st->opv_cached = f->parts->opv_textures; /* decided: every texture and grid is the kept one */
+        f->st->grids = f->plan.sun_count;
+    }
 }
 
 /* ---- volumetric: multiply scattered light, view-independent ----------- */

@@ -176,6 +176,7 @@ typedef struct veil_render_stats {
     int emission_lights;  /* of them, the medium's emission as lights (volume/emission_lights.h) */
     int fogs;             /* analytic fogs (closed form, never voxelised) */
     int opv_computed, opv_cached; /* OPV textures made / reused */
+    int grids, grids_computed; /* light-space grids in use / made by this frame (propagate/sun_space.h) */
     veil_opv_method method;
     int propagate_iterations; /* Jacobi steps or sweep passes (most of any light) */
 } veil_render_stats;

@@ -51,13 +51,30 @@ void veil_lit_medium_fill(const veil_lit_medium* d, veil_medium_block* u)
         int l = d->suns[k].light;
         if (l < 0 || l >= n) continue;
         u->sun_of[l / 4][l % 4] = k + 1;
+        const veil_sun_space* sp = &d->suns[k].space;
+        u->sun_step[k][3] = (float)l;
+        if (sp->perspective) {
+            for (int a = 0; a < 3; ++a)
+                u->sun_light[k][a] = d->grid->origin[a] + d->grid->voxel * (sp->origin[a] + 0.5f); /* index -> m */
+            u->sun_light[k][3] = 1.0f;
+            for (int a = 0; a < 3; ++a) u->sun_map[3 * k][a] = (float)sp->nodes[a];
+            u->sun_map[3 * k][3] = sp->dz;
+            u->sun_step[k][2] = (float)veil_point_space_pieces(sp);
+            for (int f = 0; f < 6; ++f) {
+                const veil_point_face* F = &sp->face[f];
+                float* a = u->sun_face[12 * k + 2 * f];
+                float* b = u->sun_face[12 * k + 2 * f + 1];
+                a[0] = F->u0, a[1] = F->v0, a[2] = F->nz ? F->du : 1.0f, a[3] = F->z0;
+                b[0] = (float)F->first, b[1] = (float)F->nu, b[2] = (float)F->nv, b[3] = (float)F->nz;
+            }
+            continue;
+        }
         for (int row = 0; row < 3; ++row) memcpy(u->sun_map[3 * k + row], d->suns[k].to_tex[row], sizeof u->sun_map[0]);
-        const float* c = d->suns[k].space.axis[2];
+        const float* c = sp->axis[2];
         float along = sqrtf(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
         u->sun_step[k][0] = along * d->grid->voxel;
-        u->sun_step[k][1] = (float)d->suns[k].space.nodes[2];
+        u->sun_step[k][1] = (float)sp->nodes[2];
         u->sun_step[k][2] = ceilf(along); /* pieces of at most a voxel, as the prefix sum's panels */
-        u->sun_step[k][3] = (float)l;
     }
     for (int l = 0; l < n; ++l) /* the rest, in order */
         if (u->sun_of[l / 4][l % 4] == 0) u->on_opv[u->counts[3] / 4][u->counts[3] % 4] = l, ++u->counts[3];

@@ -115,6 +115,22 @@ static inline float veil_opv_sun_along(const veil_opv_params* p)
 {
     return p->sun_along > 0.0f ? p->sun_along : VEIL_SUN_DEFAULT_ALONG;
 }
+/* A point or spot light's grid (the perspective form of sun_space.h):
+ * columns VEIL_POINT_ACROSS_SCALE times a sun's spacing apart at the far
+ * side of the box (finer nearer the light), planes half as far apart as a
+ * sun's (its stretch back runs up to sqrt(3) times the planes' spacing).
+ * 1.4: the prefix sums then cost about what the semi-Lagrangian pass they
+ * replace did on the shared smoke (docs/performance.md, "Point and spot
+ * lights in light-space grids"). */
+#define VEIL_POINT_ACROSS_SCALE 1.4f
+static inline float veil_opv_point_across(const veil_opv_params* p)
+{
+    return VEIL_POINT_ACROSS_SCALE * veil_opv_sun_across(p);
+}
+static inline float veil_opv_point_along(const veil_opv_params* p)
+{
+    return 0.5f * veil_opv_sun_along(p);
+}
 static inline int veil_opv_sun_panels(const veil_opv_params* p)
 {
     return p->sun_panels > 0 ? p->sun_panels : VEIL_SUN_DEFAULT_PANELS;

@@ -63,13 +63,19 @@ VEIL_STRUCT_BEGIN(veil_sparse_od_block)
     VEIL_IV4(pass); /* x: the channel written, 0..3; y: this pass's first entry of the slot list; zw: - */
 VEIL_STRUCT_END(veil_sparse_od_block)
 
-/* A sun's prefix sums in its light-space grid (sun_prefix.comp,
- * propagate/sun_space.h). */
+/* The prefix sums of a light-space grid (sun_prefix.comp,
+ * propagate/sun_space.h): a sun's grid, or one face of a point light's
+ * (veil_sun_space_columns: column (a, b) from origin + a axis[0] + b axis[1],
+ * step axis[2] + a spread[0] + b spread[1]). */
 VEIL_STRUCT_BEGIN(veil_sun_block)
-    VEIL_IV4(dims);    /* xyz: the EV's voxels; w: Simpson panels per step along c */
-    VEIL_IV4(nodes);   /* xyz: nodes along a, b, c; w: 1: skip the panels of empty occupancy bricks */
-    VEIL_V4(origin);   /* xyz: node (0, 0, 0); w: metres per node step along c */
-    VEIL_V4(axis[3]);  /* xyz: the index-space step between nodes along a, b, c; w: - */
+    VEIL_IV4(dims);    /* xyz: the EV's voxels; w: Simpson panels per step along c (the least) */
+    VEIL_IV4(nodes);   /* xyz: columns along a, b and nodes along c written; w: bit 0: skip the panels of
+                          empty occupancy bricks, bit 1: perspective (a step per column, panels to match) */
+    VEIL_V4(origin);   /* xyz: node (0, 0, 0); w: metres per node step along c (a sun's) */
+    VEIL_V4(axis[3]);  /* xyz: the index-space steps, as above; w: - */
+    VEIL_V4(spread[2]); /* xyz: as above; [0].w: the voxel edge (m) */
+    VEIL_IV4(place);   /* x: the first plane written; yz: the columns the dispatch covers (those past
+                          nodes.xy get 0); w: - */
 VEIL_STRUCT_END(veil_sun_block)
 
 #ifndef VEIL_GLSL
@@ -83,7 +89,8 @@ _Static_assert(offsetof(veil_sweep_block, pass) == 16 * 4, "veil_sweep_block: st
 _Static_assert(offsetof(veil_sweep_block, boxes) == 16 * 5, "veil_sweep_block: std140 offset of boxes");
 _Static_assert(sizeof(veil_sparse_od_block) == 32, "veil_sparse_od_block: std140 size");
 _Static_assert(offsetof(veil_sparse_od_block, pass) == 16, "veil_sparse_od_block: std140 offset of pass");
-_Static_assert(sizeof(veil_sun_block) == 16 * 6, "veil_sun_block: std140 size");
+_Static_assert(sizeof(veil_sun_block) == 16 * 9, "veil_sun_block: std140 size");
+_Static_assert(offsetof(veil_sun_block, place) == 16 * 8, "veil_sun_block: std140 offset of place");
 #endif
 
 #endif

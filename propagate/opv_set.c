@@ -272,9 +272,9 @@ static veil_result sparse_depths(veil_opv_set* s, const veil_ev_sparse* sp, cons
     return r;
 }
 
-/* Fills texture tex (r32f, the nodes of sp) with one sun's light-space
+/* Fills texture tex (r32f, the nodes of sp) with one light's light-space
  * optical depth over the EV texture ev (occ: its occupancy bricks, 0: no
- * skipping). */
+ * skipping): a sun's grid in one dispatch, a point light's a face at a time. */
 static veil_result sun_depths(veil_opv_set* s, const veil_grid* g, GLuint ev, GLuint occ, const veil_sun_space* sp,
                               GLuint tex, veil_error* err)
 {
@@ -284,32 +284,46 @@ static veil_result sun_depths(veil_opv_set* s, const veil_grid* g, GLuint ev, GL
                            &s->sun_block, err);
     if (r == VEIL_OK && !s->sun_program) r = veil_gpu_program("propagate/shaders/sun_prefix.comp", &s->sun_program, err);
     if (r != VEIL_OK) return r;
-    const float* c = sp->axis[2];
-    veil_sun_block blk;
-    memset(&blk, 0, sizeof blk);
-    for (int a = 0; a < 3; ++a) {
-        blk.dims[a] = g->dims[a];
-        blk.nodes[a] = sp->nodes[a];
-        blk.origin[a] = sp->origin[a];
-        for (int k = 0; k < 3; ++k) blk.axis[k][a] = sp->axis[k][a];
-    }
-    blk.dims[3] = sp->panels;
-    blk.nodes[3] = occ != 0;
-    blk.origin[3] = sqrtf(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) * g->voxel; /* m a step along c */
-    glNamedBufferSubData(s->sun_block, 0, sizeof blk, &blk);
     glUseProgram(s->sun_program);
     glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, s->sun_block);
     glBindTextureUnit(VEIL_TEX_EV, ev);
     glBindTextureUnit(VEIL_TEX_OCC, occ);
     glBindImageTexture(VEIL_IMAGE_OPV_DST, tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
-    glDispatchCompute(veil_groups(sp->nodes[0], 8), veil_groups(sp->nodes[1], 8), 1);
+    for (int f = 0; f < (sp->perspective ? 6 : 1); ++f) {
+        if (sp->perspective && sp->face[f].nz == 0) continue;
+        float fr[6][3];
+        veil_sun_space_columns(sp, f, fr);
+        veil_sun_block blk;
+        memset(&blk, 0, sizeof blk);
+        for (int a = 0; a < 3; ++a) {
+            blk.dims[a] = g->dims[a];
+            blk.origin[a] = fr[0][a];
+            for (int k = 0; k < 3; ++k) blk.axis[k][a] = fr[1 + k][a];
+            blk.spread[0][a] = fr[4][a];
+            blk.spread[1][a] = fr[5][a];
+        }
+        blk.dims[3] = sp->panels;
+        blk.nodes[3] = (occ != 0) | (sp->perspective ? 2 : 0);
+        const float* c = sp->axis[2];
+        blk.origin[3] = sqrtf(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) * g->voxel; /* m a step along c (a sun's) */
+        blk.spread[0][3] = g->voxel;
+        if (sp->perspective) {
+            blk.nodes[0] = sp->face[f].nu, blk.nodes[1] = sp->face[f].nv, blk.nodes[2] = sp->face[f].nz;
+            blk.place[0] = sp->face[f].first;
+        } else {
+            for (int a = 0; a < 3; ++a) blk.nodes[a] = sp->nodes[a];
+        }
+        blk.place[1] = sp->nodes[0], blk.place[2] = sp->nodes[1];
+        glNamedBufferSubData(s->sun_block, 0, sizeof blk, &blk);
+        glDispatchCompute(veil_groups(sp->nodes[0], 8), veil_groups(sp->nodes[1], 8), 1);
+    }
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     glBindImageTexture(VEIL_IMAGE_OPV_DST, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
     glBindTextureUnit(VEIL_TEX_EV, 0);
     glBindTextureUnit(VEIL_TEX_OCC, 0);
     glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_PROPAGATE, 0);
     glUseProgram(0);
-    return veil_gl_check("a sun's light-space optical depth (propagate/shaders/sun_prefix.comp)", err);
+    return veil_gl_check("a light's light-space optical depth (propagate/shaders/sun_prefix.comp)", err);
 }
 
 int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* lights, int n,
@@ -319,10 +333,10 @@ int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* li
     int count = 0;
     for (int l = 0; l < n; ++l) veil_light_to_index(&lights[l], g->dims, g->origin, g->voxel, &ol[l]);
     if (params->method != VEIL_OPV_LIGHT_SPACE) return 0;
-    int suns = 0; /* the memory allowed is shared by the suns that may get a grid */
-    for (int l = 0; l < n && suns < VEIL_MAX_SUNS; ++l) suns += lights[l].type == VEIL_LIGHT_DIRECTIONAL;
+    int suns = 0; /* the memory allowed is shared by the lights that may get a grid */
+    for (int l = 0; l < n && suns < VEIL_MAX_SUNS; ++l) suns += ol[l].type == VEIL_LIGHT_DIRECTIONAL || ol[l].type == VEIL_LIGHT_POINT;
     for (int l = 0; l < n && count < VEIL_MAX_SUNS; ++l) {
-        if (lights[l].type != VEIL_LIGHT_DIRECTIONAL) continue;
+        const int sun = ol[l].type == VEIL_LIGHT_DIRECTIONAL;
         veil_opv_sun* w = &want[count];
         memset(w, 0, sizeof *w);
         veil_error ignored;
@@ -332,14 +346,17 @@ int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* li
             most = (size_t)(params->sun_bytes / (4.0 * suns)); /* r32f nodes */
         /* the spacing asked for, widened across the light by 5/4 at a time until the grid fits
          * (up to VEIL_SUN_WIDEST voxels, or what was asked if wider) */
-        float across = veil_opv_sun_across(params), widest = across > VEIL_SUN_WIDEST ? across : VEIL_SUN_WIDEST;
+        float across = sun ? veil_opv_sun_across(params) : veil_opv_point_across(params);
+        float widest = across > VEIL_SUN_WIDEST ? across : VEIL_SUN_WIDEST;
         veil_result made = VEIL_ERR_LIMIT;
         for (; made != VEIL_OK && across <= widest; across *= 1.25f)
-            made = veil_sun_space_make(g, lights[l].direction, across, veil_opv_sun_along(params),
-                                       veil_opv_sun_panels(params), max_axis, most, &w->space, &ignored);
-        if (made != VEIL_OK) continue; /* too large a grid even so: this sun stays on the EV's grid */
+            made = sun ? veil_sun_space_make(g, lights[l].direction, across, veil_opv_sun_along(params),
+                                             veil_opv_sun_panels(params), max_axis, most, &w->space, &ignored)
+                       : veil_point_space_make(g, ol[l].v, across, veil_opv_point_along(params),
+                                               veil_opv_sun_panels(params), max_axis, most, &w->space, &ignored);
+        if (made != VEIL_OK) continue; /* too large a grid even so: this light stays on the EV's grid */
         w->light = l;
-        veil_sun_space_to_texture(g, &w->space, w->to_tex);
+        if (sun) veil_sun_space_to_texture(g, &w->space, w->to_tex);
         want_key[count] = veil_hash_bytes(params_key(ev_key, params), &w->space, sizeof w->space);
         ol[l].elsewhere = 1;
         ++count;
@@ -386,8 +403,7 @@ static veil_result update_suns(veil_opv_set* s, const veil_grid* g, GLuint ev, G
     }
     rep->suns = count;
     for (int k = 0; k < count; ++k) {
-        const float* a = s->sun[k].space.axis[0];
-        float across = sqrtf(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        float across = s->sun[k].space.across;
         rep->sun_across = across > rep->sun_across ? across : rep->sun_across;
     }
     for (int k = 0; k < count; ++k) rep->mib += (double)veil_sun_space_nodes(&s->sun[k].space) * 4.0 / 1048576.0;

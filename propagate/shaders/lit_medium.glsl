@@ -44,11 +44,13 @@ float fog_integral(vec3 p, vec3 d, float t0, float t1)
 // over length `len` (INF for a sun): the optical-depth volume at x, or at
 // the point where that path enters the EV's box. With `grid` true, from
 // light-space grid k (light l's: med.sun_of), else from light l's channel of
-// the OPVs. A caller that knows `grid` when the shader is compiled passes a
-// constant (the march's two light loops): llvmpipe runs both sides of a
-// branch it cannot fold, and the grid's side cost the march 1.35x in every
-// light's lookup (docs/performance.md).
-float ev_depth_in(int l, bool grid, int k, vec3 x, vec3 to, float len)
+// the OPVs; `persp`: grid k is a point or spot light's (med.sun_light[k].w).
+// A caller that knows `grid` and `persp` when the shader is compiled passes
+// constants (the march's light list): llvmpipe runs both sides of a branch
+// it cannot fold, and the grid's side cost the march 1.35x in every light's
+// lookup (docs/performance.md). Where `persp` is not constant both forms'
+// coordinates are computed (arithmetic only) and one texture read serves.
+float ev_depth_in(int l, bool grid, bool persp, int k, vec3 x, vec3 to, float len)
 {
     if (med.counts.z == 0) return 0.0;
 #ifdef VEIL_SPARSE
@@ -64,7 +66,7 @@ float ev_depth_in(int l, bool grid, int k, vec3 x, vec3 to, float len)
     vec2 s = box_hit(x, to, med.box_min.xyz, med.box_max.xyz, 0.0, len);
     if (s.x > s.y) return 0.0;
     vec3 y = x + to * s.x; // where the path enters the box; s.y - s.x of it lies inside
-    if (grid) { // a sun in its light-space grid (propagate/sun_space.h)
+    if (grid) { // a light in its light-space grid (propagate/sun_space.h)
         // D on the node plane just towards the light (bilinear within the
         // plane, none between planes) plus the density over the stretch
         // back to y, midpoint rule in sun_step.z pieces of at most a voxel:
@@ -76,6 +78,18 @@ float ev_depth_in(int l, bool grid, int k, vec3 x, vec3 to, float len)
         float c0 = max(floor(c), 0.0);
         float back = (c - c0) * med.sun_step[k].x; // m to the plane, towards the light
         q.z = (c0 + 0.5) / med.sun_step[k].y;
+        if (persp) { // the face of the cube around the light that y lies in, (u, v) and depth z there
+            vec3 w = (y - med.sun_light[k].xyz) / med.shape.y, aw = abs(w);
+            int a = aw.x >= aw.y && aw.x >= aw.z ? 0 : aw.y >= aw.z ? 1 : 2;
+            float z = max(aw[a], 1e-6);
+            vec2 uv = vec2(w[(a + 1) % 3], w[(a + 2) % 3]) / z;
+            int f = 12 * k + 2 * (2 * a + (w[a] < 0.0 ? 1 : 0));
+            vec4 F = med.sun_face[f], P = med.sun_face[f + 1], T = med.sun_map[3 * k];
+            float cz = clamp(floor((z - F.w) / T.w), 0.0, P.w - 1.0);
+            back = max(z - (F.w + cz * T.w), 0.0) / z * length(w) * med.shape.y;
+            vec2 t = clamp((uv - F.xy) / F.z, vec2(0.0), P.yz - 1.0);
+            q = (vec3(t, P.x + cz) + 0.5) / T.xyz;
+        }
         float D = texture(u_sun[k], q).r;
         // the stretch's part in the box (the medium ends at its faces: a piece across one would
         // count density beyond it)
@@ -94,7 +108,8 @@ int sun_of(int l) { return med.sun_of[l / 4][l % 4] - 1; }
 
 // The lights read from the OPVs (med.on_opv, med.counts.w of them) and those
 // from light-space grids (med.counts.x - med.counts.w: grid k holds light
-// med.sun_step[k].w), for loops that take each kind apart.
+// med.sun_step[k].w, a sun, point or spot light), for loops that take each
+// kind apart.
 int opv_lights() { return med.counts.w; }
 int opv_light(int i) { return med.on_opv[i / 4][i % 4]; }
 int grid_suns() { return med.counts.x - med.counts.w; }
@@ -201,14 +216,14 @@ bool light_at(int l, vec3 x, out vec3 travel, out vec3 E, out float len)
 // The density integral from x to light l (EV and fogs). A fog's closed form
 // overflows to +inf for rho0 e^60 len > 3.4e38: kept finite so that a channel
 // with sigma_t = 0 gets exp(0) = 1, not exp(0 * inf) = NaN.
-// `grid` and k as in ev_depth_in.
-float depth_to_light_in(int l, bool grid, int k, vec3 x, vec3 travel, float len)
+// `grid`, `persp` and k as in ev_depth_in.
+float depth_to_light_in(int l, bool grid, bool persp, int k, vec3 x, vec3 travel, float len)
 {
-    return min(ev_depth_in(l, grid, k, x, -travel, len) + fog_integral(x, -travel, 0.0, len), INF);
+    return min(ev_depth_in(l, grid, persp, k, x, -travel, len) + fog_integral(x, -travel, 0.0, len), INF);
 }
 
 float depth_to_light(int l, vec3 x, vec3 travel, float len)
 {
     int k = sun_of(l);
-    return depth_to_light_in(l, k >= 0, k, x, travel, len);
+    return depth_to_light_in(l, k >= 0, k >= 0 && med.sun_light[max(k, 0)].w > 0.5, max(k, 0), x, travel, len);
 }

@@ -1,12 +1,13 @@
-// veil — a sun's optical depth in its light-space grid (propagate/sun_space.h):
-// one invocation per column (a, b), a prefix sum down the column along the
-// light's travel, node by node, each step integrated with g_panels Simpson
-// panels clipped to the medium's box; D in density * m. Panels whose
-// occupancy brick is empty add nothing and fetch nothing: a panel is at
-// most one voxel long, so it lies within half a voxel of its midpoint m,
-// and the brick b = floor((m + 1/2) / VEIL_BRICK) has 8b - 1/2 <= m <
-// 8b + 15/2, whose zero region [8b - 1, 8b + 8] (the brick and its ring:
-// volume/shaders/occupancy.comp) then holds the whole panel.
+// veil — optical depth in a light-space grid (propagate/sun_space.h): a
+// sun's, or one face of a point or spot light's. One invocation per column
+// (a, b), a prefix sum down the column along the light's travel, node by
+// node, each step integrated with Simpson panels clipped to the medium's
+// box; D in density * m. Panels whose occupancy brick is empty add nothing
+// and fetch nothing: a panel is at most one voxel long, so it lies within
+// half a voxel of its midpoint m, and the brick b = floor((m + 1/2) /
+// VEIL_BRICK) has 8b - 1/2 <= m < 8b + 15/2, whose zero region [8b - 1,
+// 8b + 8] (the brick and its ring: volume/shaders/occupancy.comp) then
+// holds the whole panel.
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = VEIL_TEX_EV) uniform sampler3D u_ev;   // density, trilinear
@@ -18,11 +19,11 @@ layout(std140, binding = VEIL_UBO_PROPAGATE) uniform veil_sun_ubo { veil_sun_blo
 // The block's fields, copied once an invocation (main) so that the loops
 // read registers: a uniform block read after an image store is read again.
 ivec3 g_dims;   // the EV's voxels
-ivec3 g_nodes;  // light-space nodes along a, b, c
+ivec3 g_nodes;  // columns along a, b; nodes along c
 vec3 g_origin;  // node (0, 0, 0), index coordinates
-vec3 g_axis_a;  // index-space steps between nodes
+vec3 g_axis_a;  // index-space steps between columns
 vec3 g_axis_b;
-vec3 g_axis_c;
+vec3 g_axis_c;  // between nodes down column (0, 0)
 int g_panels;
 float g_step;   // m per node step along c
 int g_skip;     // 1: consult the occupancy bricks
@@ -40,12 +41,24 @@ bool empty(vec3 m)
 void main()
 {
     g_dims = sb.dims.xyz, g_panels = sb.dims.w;
-    g_nodes = sb.nodes.xyz, g_skip = sb.nodes.w;
+    g_nodes = sb.nodes.xyz, g_skip = sb.nodes.w & 1;
     g_origin = sb.origin.xyz, g_step = sb.origin.w;
     g_axis_a = sb.axis[0].xyz, g_axis_b = sb.axis[1].xyz, g_axis_c = sb.axis[2].xyz;
+    const bool perspective = (sb.nodes.w & 2) != 0;
+    const int first = sb.place.x;
     ivec2 ab = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(ab, g_nodes.xy))) return;
+    if (any(greaterThanEqual(ab, sb.place.yz))) return;
+    if (any(greaterThanEqual(ab, g_nodes.xy))) { // a perspective face's texture past its window
+        for (int k = 0; k < g_nodes.z; ++k) imageStore(u_out, ivec3(ab, first + k), vec4(0.0));
+        return;
+    }
     vec3 p0 = g_origin + float(ab.x) * g_axis_a + float(ab.y) * g_axis_b;
+    if (perspective) { // each column its own step, its panels at most a voxel
+        g_axis_c += float(ab.x) * sb.spread[0].xyz + float(ab.y) * sb.spread[1].xyz;
+        float len = length(g_axis_c);
+        g_panels = max(g_panels, int(ceil(len)));
+        g_step = len * sb.spread[0].w;
+    }
     // the column's span inside the box, in node steps
     float enter = 0.0, leave = float(g_nodes.z - 1);
     for (int a = 0; a < 3; ++a) {
@@ -59,11 +72,11 @@ void main()
         leave = min(leave, max(t0, t1));
     }
     float D = 0.0, s_last = -1.0, f_last = 0.0;
-    imageStore(u_out, ivec3(ab, 0), vec4(0.0));
-    int first = max(1, int(floor(enter)));     // nodes before the box: 0
+    imageStore(u_out, ivec3(ab, first), vec4(0.0));
+    int from = max(1, int(floor(enter)));     // nodes before the box: 0
     int last = min(g_nodes.z - 1, int(ceil(leave)));
-    for (int k = 1; k < first && k < g_nodes.z; ++k) imageStore(u_out, ivec3(ab, k), vec4(0.0));
-    for (int k = first; k <= last; ++k) {
+    for (int k = 1; k < from && k < g_nodes.z; ++k) imageStore(u_out, ivec3(ab, first + k), vec4(0.0));
+    for (int k = from; k <= last; ++k) {
         float lo = max(float(k - 1), enter), hi = min(float(k), leave);
         if (lo < hi) {
             float w = (hi - lo) / float(g_panels), sum = 0.0;
@@ -83,7 +96,7 @@ void main()
             }
             D += sum * (g_step / 6.0);
         }
-        imageStore(u_out, ivec3(ab, k), vec4(D));
+        imageStore(u_out, ivec3(ab, first + k), vec4(D));
     }
-    for (int k = max(last + 1, first); k < g_nodes.z; ++k) imageStore(u_out, ivec3(ab, k), vec4(D));
+    for (int k = max(last + 1, from); k < g_nodes.z; ++k) imageStore(u_out, ivec3(ab, first + k), vec4(D));
 }

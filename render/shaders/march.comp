@@ -99,7 +99,7 @@ void light_in(int l, int kind, bool grid, int k, vec3 x, vec3 dir, float p_cam, 
     vec3 travel, E;
     float len;
     if (!light_at_kind(l, kind, x, travel, E, len)) return;
-    float D = depth_to_light_in(l, grid, k, x, travel, len);
+    float D = depth_to_light_in(l, grid, kind != VEIL_LIGHT_DIRECTIONAL, k, x, travel, len);
     float cos_theta = clamp(dot(travel, -dir), -1.0, 1.0);
     sum += E * exp(-med.sigma_t.rgb * D) * veil_phase_hg(cos_theta, med.shape.z);
     // the chance that light on the two legs through x (from the light,
@@ -160,15 +160,18 @@ vec3 in_scattered(vec3 x, vec3 dir, float p_cam, out vec3 multi)
     VEIL_LIGHT_LIST
 #undef VEIL_LIGHT
 #else
-    // the lights read from the OPVs, then the suns in light-space grids: two
-    // loops, so that neither runs the other's lookup (ev_depth_in)
+    // the lights read from the OPVs, then those in light-space grids (suns,
+    // point and spot lights): two loops, so that neither runs the other's
+    // lookup (ev_depth_in)
     for (int i = 0; i < opv_lights(); ++i) {
         int l = opv_light(i);
         light_in(l, int(med.lights[l].position.w), false, 0, x, dir, p_cam, octaves, albedo, floor_t, use_escape, escape, sum, multi);
     }
-    for (int k = 0; k < grid_suns(); ++k)
-        light_in(grid_sun_light(k), VEIL_LIGHT_DIRECTIONAL, true, k, x, dir, p_cam, octaves, albedo, floor_t, use_escape, escape,
-                 sum, multi);
+    for (int k = 0; k < grid_suns(); ++k) {
+        int l = grid_sun_light(k);
+        light_in(l, int(med.lights[l].position.w), true, k, x, dir, p_cam, octaves, albedo, floor_t, use_escape, escape, sum,
+                 multi);
+    }
 #endif
     // the diffusion estimate: the fluence of light scattered at least once,
     // scattered again, isotropically, towards the camera

@@ -1,6 +1,7 @@
-/* A sun's light-space grid on the GPU (propagate/shaders/sun_prefix.comp)
+/* A light-space grid on the GPU (propagate/shaders/sun_prefix.comp)
  * against its C twin (veil_sun_space_cpu), on puffs of smoke with empty
- * space between them.
+ * space between them: three suns, and two point lights' perspective grids
+ * (one inside the box, all six faces; one outside it).
  *
  * 1. Skipping empty bricks changes nothing: a skipped panel lies where
  *    the field is 0 (shader comment), so it adds exactly 0 either way and
@@ -37,10 +38,15 @@ int main(void)
     const float spacing[3][2] = {{0.5f, 4.0f}, {1.0f, 1.0f}, {0.7f, 2.5f}};
     GLint max_axis = 0;
     glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max_axis);
-    for (int d = 0; d < 3 && set; ++d) {
+    const float points[2][3] = {{20.3f, 16.8f, 15.1f}, {-12.0f, 40.0f, 8.0f}}; /* index coordinates */
+    for (int d = 0; d < 5 && set; ++d) {
         veil_sun_space s;
-        CHECK(veil_sun_space_make(&g, dirs[d], spacing[d][0], spacing[d][1], 1, max_axis, VEIL_SUN_MAX_NODES, &s, &err) ==
-                  VEIL_OK, "%s", err.msg);
+        if (d < 3)
+            CHECK(veil_sun_space_make(&g, dirs[d], spacing[d][0], spacing[d][1], 1, max_axis, VEIL_SUN_MAX_NODES, &s,
+                                      &err) == VEIL_OK, "%s", err.msg);
+        else
+            CHECK(veil_point_space_make(&g, points[d - 3], 0.5f, 2.0f, 1, max_axis, VEIL_SUN_MAX_NODES, &s, &err) ==
+                      VEIL_OK, "%s", err.msg);
         size_t n = veil_sun_space_nodes(&s);
         float* cpu = malloc(n * sizeof *cpu);
         float* skip = malloc(n * sizeof *skip);
@@ -50,7 +56,7 @@ int main(void)
         CHECK(veil_opv_set_sun_readback(set, &g, rho, &s, 0, noskip, &err) == VEIL_OK, "%s", err.msg);
         CHECK(!memcmp(skip, noskip, n * sizeof *skip), "dir %d: skipping empty bricks changed the optical depth", d);
         const float* a = s.axis[2];
-        double step = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]) * g.voxel, worst = 0, dmax = 0;
+        double step = (s.perspective ? s.dz : sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])) * g.voxel, worst = 0, dmax = 0;
         double box = sqrt((double)g.dims[0] * g.dims[0] + g.dims[1] * g.dims[1] + g.dims[2] * g.dims[2]) * g.voxel;
         size_t bad = 0;
         for (size_t i = 0; i < n; ++i) {
