@@ -116,16 +116,26 @@ static inline float veil_opv_sun_along(const veil_opv_params* p)
     return p->sun_along > 0.0f ? p->sun_along : VEIL_SUN_DEFAULT_ALONG;
 }
 /* A point or spot light's grid (the perspective form of sun_space.h):
- * columns VEIL_POINT_ACROSS_SCALE times a sun's spacing apart at the far
- * side of the box (finer nearer the light), planes half as far apart as a
- * sun's (its stretch back runs up to sqrt(3) times the planes' spacing).
- * 1.4: the prefix sums then cost about what the semi-Lagrangian pass they
- * replace did on the shared smoke (docs/performance.md, "Point and spot
- * lights in light-space grids"). */
+ * columns at least VEIL_POINT_ACROSS_SCALE times a sun's spacing apart at
+ * the far side of the box (finer nearer the light), planes half as far
+ * apart as a sun's (its stretch back runs up to sqrt(3) times the planes'
+ * spacing), and wider still where the columns' length in the box would
+ * exceed veil_opv_point_work voxels per voxel of the EV: VEIL_POINT_WORK at
+ * the default spacing, scaled with the rung's work (the inverse square of
+ * its spacing). At 5 the prefix sums cost about what the semi-Lagrangian
+ * pass they replace does: measured equal at 4.6 (the demo's lights, inside
+ * its box) and 6.7 (the shared smoke's, beside it) columns' voxels a voxel
+ * (docs/performance.md, "Point and spot lights in light-space grids"). */
 #define VEIL_POINT_ACROSS_SCALE 1.4f
+#define VEIL_POINT_WORK 5.0
 static inline float veil_opv_point_across(const veil_opv_params* p)
 {
     return VEIL_POINT_ACROSS_SCALE * veil_opv_sun_across(p);
+}
+static inline double veil_opv_point_work(const veil_opv_params* p)
+{
+    double r = (double)VEIL_SUN_DEFAULT_ACROSS / veil_opv_sun_across(p);
+    return VEIL_POINT_WORK * r * r;
 }
 static inline float veil_opv_point_along(const veil_opv_params* p)
 {

@@ -349,11 +349,17 @@ int veil_opv_plan_suns(const veil_grid* g, uint64_t ev_key, const veil_light* li
         float across = sun ? veil_opv_sun_across(params) : veil_opv_point_across(params);
         float widest = across > VEIL_SUN_WIDEST ? across : VEIL_SUN_WIDEST;
         veil_result made = VEIL_ERR_LIMIT;
-        for (; made != VEIL_OK && across <= widest; across *= 1.25f)
+        /* a point light's grid also widens until its prefix sums cost no more than the semi-Lagrangian
+         * pass would (veil_opv_point_work) */
+        const double work = sun ? 0.0 : veil_opv_point_work(params) * (double)voxels;
+        for (; made != VEIL_OK && across <= widest; across *= 1.25f) {
             made = sun ? veil_sun_space_make(g, lights[l].direction, across, veil_opv_sun_along(params),
                                              veil_opv_sun_panels(params), max_axis, most, &w->space, &ignored)
                        : veil_point_space_make(g, ol[l].v, across, veil_opv_point_along(params),
                                                veil_opv_sun_panels(params), max_axis, most, &w->space, &ignored);
+            if (made == VEIL_OK && !sun && across * 1.25f <= widest && veil_point_space_work(g, &w->space) > work)
+                made = VEIL_ERR_LIMIT;
+        }
         if (made != VEIL_OK) continue; /* too large a grid even so: this light stays on the EV's grid */
         w->light = l;
         if (sun) veil_sun_space_to_texture(g, &w->space, w->to_tex);

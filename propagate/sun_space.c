@@ -316,6 +316,38 @@ void veil_sun_space_cpu(const veil_grid* g, const float* rho, const veil_sun_spa
     }
 }
 
+double veil_point_space_work(const veil_grid* g, const veil_sun_space* s)
+{
+    double work = 0.0;
+    for (int f = 0; f < 6; ++f) {
+        const veil_point_face* F = &s->face[f];
+        if (F->nz == 0) continue;
+        float fr[6][3];
+        veil_sun_space_columns(s, f, fr);
+        for (int j = 0; j < F->nv; ++j)
+            for (int i = 0; i < F->nu; ++i) {
+                double p0[3], ax[3], enter = 0.0, leave = F->nz - 1, len = 0.0;
+                for (int a = 0; a < 3; ++a) {
+                    p0[a] = fr[0][a] + i * (double)fr[1][a] + j * (double)fr[2][a];
+                    ax[a] = fr[3][a] + (i * (double)fr[4][a] + j * (double)fr[5][a]);
+                    len += ax[a] * ax[a];
+                }
+                for (int a = 0; a < 3; ++a) {
+                    double hi = g->dims[a] - 1;
+                    if (ax[a] == 0.0) {
+                        if (p0[a] < 0.0 || p0[a] > hi) leave = -1.0;
+                        continue;
+                    }
+                    double t0 = -p0[a] / ax[a], t1 = (hi - p0[a]) / ax[a];
+                    enter = fmax(enter, fmin(t0, t1));
+                    leave = fmin(leave, fmax(t0, t1));
+                }
+                if (leave > enter) work += (leave - enter) * sqrt(len);
+            }
+    }
+    return work;
+}
+
 float veil_point_space_depth(const veil_grid* g, const float* rho, const veil_sun_space* s, const float* D,
                              const float y[3], float room, int pieces)
 {

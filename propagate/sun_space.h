@@ -139,6 +139,11 @@ void veil_sun_space_columns(const veil_sun_space* s, int f, float frame[6][3]);
 float veil_point_space_depth(const veil_grid* g, const float* rho, const veil_sun_space* s, const float* D,
                              const float y[3], float room, int pieces);
 
+/* The prefix sums' work for a perspective grid: the length of all its
+ * columns inside the box, in voxels (each voxel of it about two density
+ * fetches, Simpson panels of at most a voxel). */
+double veil_point_space_work(const veil_grid* g, const veil_sun_space* s);
+
 /* The longest piece of a perspective grid's stretch back (voxels): two
  * pieces of at most 2 voxels at the default planes 2 voxels apart erred
  * 0.20 / 0.30 % on the shared smoke at 128^3 (a light inside the box /
