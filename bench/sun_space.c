@@ -53,13 +53,15 @@ typedef struct config {
 
 static const config configs[] = {
     {"semi-lagrangian", 0, 0, 0, 0, -1, 0},
-    {"perspective 1.4/2 (draft)", 1, 1.4f, 2.0f, 1, 1, 0},
-    {"perspective 0.7/2 (default)", 1, 0.7f, 2.0f, 1, 1, 0},
+    {"perspective as planned (default rung)", 1, 0.0f, 2.0f, 1, 1, 0},
+    {"perspective 1.4/2 (draft's least)", 1, 1.4f, 2.0f, 1, 1, 0},
+    {"perspective 1.09/2", 1, 1.09f, 2.0f, 1, 1, 0},
+    {"perspective 0.875/2", 1, 0.875f, 2.0f, 1, 1, 0},
+    {"perspective 0.7/2 (default's least)", 1, 0.7f, 2.0f, 1, 1, 0},
     {"perspective 0.7/2, 1 piece", 1, 0.7f, 2.0f, 1, 1, 1},
     {"perspective 0.7/2, pieces <= 1 voxel", 1, 0.7f, 2.0f, 1, 1, 4},
     {"perspective 0.7/4", 1, 0.7f, 4.0f, 1, 1, 0},
     {"perspective 0.5/2", 1, 0.5f, 2.0f, 1, 1, 0},
-    {"perspective 0.49/2 (high)", 1, 0.49f, 2.0f, 1, 1, 0},
     {"perspective 0.35/2", 1, 0.35f, 2.0f, 1, 1, 0},
     {"light-space 1/1", 1, 1.0f, 1.0f, 1, 0, 0},
     {"light-space 1/1, 2 panels", 1, 1.0f, 1.0f, 2, 0, 0},
@@ -260,7 +262,18 @@ int main(int argc, char** argv)
                     veil_sun_space sp;
                     float* D = grid_d;
                     if (cf->light_space) {
-                        veil_result made =
+                        veil_result made = VEIL_OK;
+                        if (point && cf->across == 0.0f) { /* the spacing the renderer's plan picks */
+                            veil_opv_params dp = {.method = VEIL_OPV_LIGHT_SPACE};
+                            veil_index_light pl;
+                            veil_opv_sun want[VEIL_MAX_SUNS];
+                            uint64_t keys[VEIL_MAX_SUNS];
+                            if (veil_opv_plan_suns(&g, 1, &l, 1, &dp, max_axis, &pl, want, keys) == 1)
+                                sp = want[0].space;
+                            else
+                                made = veil_fail(&err, VEIL_ERR_LIMIT, "the plan gave the light no grid");
+                        } else
+                            made =
                             point ? veil_point_space_make(&g, ol.v, cf->across, cf->along, cf->panels, max_axis,
                                                           VEIL_SUN_MAX_NODES, &sp, &err)
                                   : veil_sun_space_make(&g, l.direction, cf->across, cf->along, cf->panels, max_axis,
@@ -302,8 +315,11 @@ int main(int argc, char** argv)
                             ++counted;
                         }
                     }
+                    char name[96];
+                    snprintf(name, sizeof name, cf->light_space && point && cf->across == 0.0f ? "%s: %.3g/%g" : "%s",
+                             cf->name, (double)sp.across, (double)sp.dz);
                     printf("| %s | %d³ | %s | %s | %.2f | %.0f | %.3f %% | %.1e |\n", medium_names[med], sizes[si], light_names[li],
-                           cf->name, cf->light_space ? veil_sun_space_nodes(&sp) / 1e6 : nv / 1e6, times[runs / 2],
+                           name, cf->light_space ? veil_sun_space_nodes(&sp) / 1e6 : nv / 1e6, times[runs / 2],
                            counted ? 100.0 * sqrt(sum2 / counted) : NAN, max_t);
                     fflush(stdout);
                     if (cf->light_space) free(D);

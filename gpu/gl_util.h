@@ -25,6 +25,11 @@ veil_result veil_gl_compute_program(const char* file, const char* source, GLuint
 veil_result veil_gl_texture3d(GLenum internal_format, const int dims[3], const char* label,
                               GLuint* out, veil_error* err);
 
+/* 2D array texture of dims[2] layers of dims[0] x dims[1], otherwise as
+ * veil_gl_texture3d: a lookup that reads one layer filters 4 texels, not 8. */
+veil_result veil_gl_texture2d_array(GLenum internal_format, const int dims[3], const char* label, GLuint* out,
+                                    veil_error* err);
+
 /* Immutable buffer with the given contents (size 0 allowed: 4 bytes). */
 veil_result veil_gl_buffer(const void* data, size_t bytes, GLbitfield flags, const char* label,
                            GLuint* out, veil_error* err);

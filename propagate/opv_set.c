@@ -401,7 +401,7 @@ static veil_result update_suns(veil_opv_set* s, const veil_grid* g, GLuint ev, G
             continue;
         }
         s->sun[k] = want[k];
-        if (r == VEIL_OK) r = veil_gl_texture3d(GL_R32F, want[k].space.nodes, "veil light-space optical depth",
+        if (r == VEIL_OK) r = veil_gl_texture2d_array(GL_R32F, want[k].space.nodes, "veil light-space optical depth",
                                                 &s->sun[k].texture, err);
         if (r == VEIL_OK) r = sun_depths(s, g, ev, occ, &want[k].space, s->sun[k].texture, err);
         if (r == VEIL_OK) s->sun_key[k] = want_key[k];
@@ -562,7 +562,7 @@ veil_result veil_opv_set_sun_readback(veil_opv_set* s, const veil_grid* g, const
             r = veil_gl_check("uploading the occupancy", err);
         }
     }
-    if (r == VEIL_OK) r = veil_gl_texture3d(GL_R32F, space->nodes, "veil light-space optical depth", &tex, err);
+    if (r == VEIL_OK) r = veil_gl_texture2d_array(GL_R32F, space->nodes, "veil light-space optical depth", &tex, err);
     if (r == VEIL_OK) r = sun_depths(s, g, ev, occ, space, tex, err);
     if (r == VEIL_OK)
         r = veil_gl_read_texture(tex, GL_RED, veil_sun_space_nodes(space), out, "reading back a light-space grid", err);

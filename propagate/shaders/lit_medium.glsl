@@ -11,7 +11,8 @@ layout(std140, binding = VEIL_UBO_MEDIUM) uniform veil_medium_ubo { veil_medium_
 //@include volume/shaders/sparse_common.glsl
 #else
 layout(binding = VEIL_TEX_EV) uniform sampler3D u_ev;
-layout(binding = VEIL_TEX_SUN0) uniform sampler3D u_sun[VEIL_MAX_SUNS]; // suns' light-space grids
+// lights' light-space grids, a layer a node plane (the lookup reads one: bilinear, 4 texels)
+layout(binding = VEIL_TEX_SUN0) uniform sampler2DArray u_sun[VEIL_MAX_SUNS];
 #endif
 
 // The EV's density at x (inside its box).
@@ -77,18 +78,21 @@ float ev_depth_in(int l, bool grid, bool persp, int k, vec3 x, vec3 to, float le
         float c = q.z * med.sun_step[k].y - 0.5;
         float c0 = max(floor(c), 0.0);
         float back = (c - c0) * med.sun_step[k].x; // m to the plane, towards the light
-        q.z = (c0 + 0.5) / med.sun_step[k].y;
+        q.z = c0;
         if (persp) { // the face of the cube around the light that y lies in, (u, v) and depth z there
             vec3 w = (y - med.sun_light[k].xyz) / med.shape.y, aw = abs(w);
-            int a = aw.x >= aw.y && aw.x >= aw.z ? 0 : aw.y >= aw.z ? 1 : 2;
-            float z = max(aw[a], 1e-6);
-            vec2 uv = vec2(w[(a + 1) % 3], w[(a + 2) % 3]) / z;
-            int f = 12 * k + 2 * (2 * a + (w[a] < 0.0 ? 1 : 0));
+            // the major axis a, and w's components after it in turn (swizzles picked by selects: a
+            // vector indexed by a varying int is slow on llvmpipe)
+            bool ax = aw.x >= aw.y && aw.x >= aw.z, ay = !ax && aw.y >= aw.z;
+            vec3 r = ax ? w.yzx : ay ? w.zxy : w.xyz; // (u, v, signed depth) numerators
+            float z = max(abs(r.z), 1e-6);
+            vec2 uv = r.xy / z;
+            int f = 12 * k + 2 * (2 * (ax ? 0 : ay ? 1 : 2) + (r.z < 0.0 ? 1 : 0));
             vec4 F = med.sun_face[f], P = med.sun_face[f + 1], T = med.sun_map[3 * k];
             float cz = clamp(floor((z - F.w) / T.w), 0.0, P.w - 1.0);
             back = max(z - (F.w + cz * T.w), 0.0) / z * length(w) * med.shape.y;
             vec2 t = clamp((uv - F.xy) / F.z, vec2(0.0), P.yz - 1.0);
-            q = (vec3(t, P.x + cz) + 0.5) / T.xyz;
+            q = vec3((t + 0.5) / T.xy, P.x + cz);
         }
         float D = texture(u_sun[k], q).r;
         // the stretch's part in the box (the medium ends at its faces: a piece across one would

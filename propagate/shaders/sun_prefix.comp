@@ -12,7 +12,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = VEIL_TEX_EV) uniform sampler3D u_ev;   // density, trilinear
 layout(binding = VEIL_TEX_OCC) uniform sampler3D u_occ; // max density per brick, ring included
-layout(binding = VEIL_IMAGE_OPV_DST, r32f) writeonly uniform image3D u_out;
+layout(binding = VEIL_IMAGE_OPV_DST, r32f) writeonly uniform image2DArray u_out; // a layer a node plane
 
 //@include propagate/opv_blocks.glsl.h
 layout(std140, binding = VEIL_UBO_PROPAGATE) uniform veil_sun_ubo { veil_sun_block sb; };
