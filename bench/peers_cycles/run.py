@@ -2,16 +2,19 @@
 """veil against Blender 3.4 Cycles at all orders (issue 24): whole-process time against error, both
 measured against `veil reference` at every scattering order with the same metric.
 
-    /usr/bin/python3 bench/peers_cycles/run.py [--size 160x120] [--spp-list 4,16,64,256] [--runs 3]
-        [--ref-spp 4096] [--veil build/veil] [--out docs/results]
+    /usr/bin/python3 bench/peers_cycles/run.py [--scene smoke|cloud] [--size 160x120]
+        [--spp-list 4,16,64,256] [--runs 3] [--ref-spp 4096] [--veil build/veil] [--out docs/results]
 
 Needs `blender` (Debian package, CPU Cycles) and numpy with OpenImageIO for /usr/bin/python3 (the
 Cycles render is a multilayer EXR: its combined pass is copied to a plain RGBA one). Not part of
 `make test`.
 
-Scene: the shared smoke (../shared/data/smoke.vdb, at its own voxels, held dense), a sun and a point
-light, sigma_s 0.093, sigma_a 0.007, HG g 0.3, black background: bench/regress.py's smoke at --size.
-Blender reads the same file (blender_scene.py says how each part maps).
+Scenes (--scene): `smoke`, the shared smoke (../shared/data/smoke.vdb, at its own voxels, held dense),
+a sun and a point light, sigma_s 0.093, sigma_a 0.007, HG g 0.3, black background: bench/regress.py's
+smoke at --size. `cloud`, a cumulus made by cloud.py (a VDB of Gaussian puffs, 5 cm voxels, written
+to build/bench-cache/peers_cycles/), the medium and lights of data/scenes/cloud.json (sigma_s 1.6,
+sigma_a 0.004: albedo 0.9975, HG g 0.6; a sun, and a point light inside the cloud), black
+background. Blender reads the same file (blender_scene.py says how each part maps).
 
 veil: each quality rung, whole-process wall time (median of --runs). Cycles: each --spp-list entry,
 one seed, the `blender -b` process's wall time (median of --runs; Blender's own start-up, about 2-3 s,
@@ -22,7 +25,7 @@ on Cycles' curve (log-log between its two points around it; bench/peers.py's fro
 '>' where veil's error is below Cycles' best (a lower bound), '<' where it is above Cycles' fewest
 samples (an upper bound).
 
-Results: OUT/peers_cycles.{md,csv}."""
+Results: OUT/peers_cycles.{md,csv} (smoke), OUT/peers_cycles_cloud.{md,csv} (cloud)."""
 import argparse, csv, hashlib, json, os, statistics, subprocess, sys, tempfile, time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -46,13 +49,26 @@ def smoke_scene(w, h):
     sys.exit("peers_cycles: bench/regress.py has no smoke scene")
 
 
+def cloud_scene(w, h):
+    vdb = os.path.join(CACHE, "cloud.vdb")
+    if not os.path.exists(vdb):
+        peers.run(["/usr/bin/python3", os.path.join(HERE, "cloud.py"), vdb])
+    return {"camera": {"position": [0.0, 1.0, 7.5], "look_at": [0.0, 0.8, 0.0], "fov_y_deg": 40, "width": w,
+                       "height": h},
+            "medium": {"sigma_a": [0.004] * 3, "sigma_s": [1.6] * 3, "phase": {"type": "hg", "g": 0.6},
+                       "representation": "dense", "sources": [{"type": "vdb", "file": vdb}]},
+            "lights": [{"type": "directional", "direction": [0.5, -0.6, -0.62], "irradiance": [3.0, 2.9, 2.7]},
+                       {"type": "point", "position": [0.4, 0.7, 0.1], "intensity": [3.0, 1.6, 0.6]}],
+            "background": {"color": [0.0, 0.0, 0.0]}}
+
+
 def reference(a, scene_path):
     with open(scene_path, "rb") as f:
         key = hashlib.sha256(f.read())
     with open(a.veil, "rb") as f:
         key.update(f.read())
     key.update(str(a.ref_spp).encode())
-    ref = os.path.join(CACHE, "smoke_ref_%s.exr" % key.hexdigest()[:16])
+    ref = os.path.join(CACHE, "%s_ref_%s.exr" % (a.scene, key.hexdigest()[:16]))
     if not os.path.exists(ref):
         print("peers_cycles: reference, all orders, %d spp (cached for later runs) ..." % a.ref_spp, file=sys.stderr,
               flush=True)
@@ -85,6 +101,7 @@ def combined_to_rgba(src, dst):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--scene", choices=("smoke", "cloud"), default="smoke")
     ap.add_argument("--size", default="160x120")
     ap.add_argument("--spp-list", default="4,16,64,256")
     ap.add_argument("--runs", type=int, default=3)
@@ -96,9 +113,9 @@ def main():
     w, h = (int(v) for v in a.size.split("x"))
     os.makedirs(CACHE, exist_ok=True)
     tmp = tempfile.mkdtemp(prefix="peers_cycles.")
-    scene_path = os.path.join(tmp, "smoke.json")
+    scene_path = os.path.join(tmp, a.scene + ".json")
     with open(scene_path, "w") as f:
-        json.dump(smoke_scene(w, h), f)
+        json.dump(smoke_scene(w, h) if a.scene == "smoke" else cloud_scene(w, h), f)
     ref = reference(a, scene_path)
     rows = []
     for rung in RUNGS:
@@ -136,15 +153,17 @@ def main():
 
 def write(a, rows, w, h):
     os.makedirs(a.out, exist_ok=True)
-    with open(os.path.join(a.out, "peers_cycles.csv"), "w", newline="") as f:
+    stem = "peers_cycles" if a.scene == "smoke" else "peers_cycles_" + a.scene
+    with open(os.path.join(a.out, stem + ".csv"), "w", newline="") as f:
         cw = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         cw.writeheader()
         cw.writerows(rows)
     cyc = [r for r in rows if r["tool"] == "cycles"]
-    lines = ["The shared smoke at %dx%d, all orders, against `veil reference` at %d spp: `/usr/bin/python3 "
-             "bench/peers_cycles/run.py --size %dx%d --spp-list %s --runs %d --ref-spp %d` (%s). Errors are relative "
-             "RMSE with the reference's noise taken out." % (w, h, a.ref_spp, w, h, a.spp_list, a.runs, a.ref_spp,
-                                                          time.strftime("%Y-%m-%d")), "",
+    what = "The shared smoke" if a.scene == "smoke" else "The cloud (cloud.py)"
+    lines = ["%s at %dx%d, all orders, against `veil reference` at %d spp: `/usr/bin/python3 "
+             "bench/peers_cycles/run.py --scene %s --size %dx%d --spp-list %s --runs %d --ref-spp %d` (%s). Errors are "
+             "relative RMSE with the reference's noise taken out." % (what, w, h, a.ref_spp, a.scene, w, h, a.spp_list,
+                                                                     a.runs, a.ref_spp, time.strftime("%Y-%m-%d")), "",
              "| tool | setting | wall (s) | Cycles' own (s) | error, pixel | error, 4x4 | bias | Cycles at equal "
              "error, pixel | 4x4 |", "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
     fronts = {k: peers.front([(r["wall_s"], r[k]) for r in cyc]) for k in ("err_pixel", "err_4x4")}
@@ -160,7 +179,7 @@ def write(a, rows, w, h):
         lines.append("| %s | %s | %.2f | %s | %.2f %% | %.2f %% | %+.2f %% | %s | %s |" % (
             r["tool"], r["setting"], r["wall_s"], own, 100 * r["err_pixel"], 100 * r["err_4x4"], 100 * r["bias"],
             ratios[0], ratios[1]))
-    with open(os.path.join(a.out, "peers_cycles.md"), "w") as f:
+    with open(os.path.join(a.out, stem + ".md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))
 
