@@ -5,7 +5,8 @@ measured against `veil reference` at every scattering order with the same metric
     /usr/bin/python3 bench/peers_cycles/run.py [--scene smoke|cloud] [--size 160x120]
         [--spp-list 4,16,64,256] [--runs 3] [--ref-spp 4096] [--veil build/veil] [--out docs/results]
 
-Needs `blender` (Debian package, CPU Cycles) and numpy with OpenImageIO for /usr/bin/python3 (the
+Needs `blender` (Debian package, CPU Cycles), numpy with OpenImageIO for /usr/bin/python3, and for
+--scene cloud pyopenvdb (python3-openvdb: `bash scripts/install-bench-deps.sh python3-openvdb`) (the
 Cycles render is a multilayer EXR: its combined pass is copied to a plain RGBA one). Not part of
 `make test`.
 
