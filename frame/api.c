@@ -127,6 +127,23 @@ veil_result veil_scene_open(const char* path, veil_scene** out, veil_error* err)
     return VEIL_OK;
 }
 
+veil_result veil_scene_from_json(const char* json, const char* base_dir, const char* name, veil_scene** out,
+                                 veil_error* err)
+{
+    if (!out) return VEIL__NULL_ARG("veil_scene_from_json", "out");
+    *out = NULL;
+    if (!json) return VEIL__NULL_ARG("veil_scene_from_json", "json");
+    veil_scene* s = calloc(1, sizeof *s);
+    if (!s) return veil_fail(err, VEIL_ERR_OOM, "veil_scene_from_json: out of memory");
+    veil_result r = veil_scene_parse_in(name ? name : "<json>", json, strlen(json), base_dir, s, err);
+    if (r != VEIL_OK) {
+        veil_scene_close(s);
+        return r;
+    }
+    *out = s;
+    return VEIL_OK;
+}
+
 void veil_scene_close(veil_scene* scene)
 {
     if (!scene) return;

@@ -104,6 +104,13 @@ typedef struct veil_scene veil_scene;
  * VEIL_ERR_IO, VEIL_ERR_PARSE or VEIL_ERR_INVALID with the file and the
  * JSON path of the offending field. */
 VEIL_API veil_result veil_scene_open(const char* path, veil_scene** out, veil_error* err);
+
+/* The same from JSON text in memory (NUL-terminated; the scene format of
+ * docs/scene-format.md): relative paths inside resolve against base_dir
+ * (NULL or "": the current folder), and `name` (NULL: "<json>") starts
+ * every error message where a file's name would. */
+VEIL_API veil_result veil_scene_from_json(const char* json, const char* base_dir, const char* name, veil_scene** out,
+                                          veil_error* err);
 VEIL_API void veil_scene_close(veil_scene* scene); /* accepts NULL */
 
 /* ---- render ------------------------------------------------------------ */

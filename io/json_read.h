@@ -30,6 +30,7 @@ typedef struct jpath {
 typedef struct ctx {
     const char* name; /* file name, first thing in every message */
     veil_error* err;
+    const char* base; /* the folder relative paths resolve against; NULL: the name's */
 } ctx;
 
 /* Accepted numbers: [lo, hi] (or open ends), optionally integral. */

@@ -177,7 +177,7 @@ static veil_result read_json(const char* path, const char* s, size_t len, veil_p
         cJSON_Delete(root);
         return json_syntax(path, s, len, pos, err);
     }
-    const ctx c = {path, err};
+    const ctx c = {path, err, NULL};
     veil_particle* p = NULL;
     size_t n = 0;
     veil_result r = parse_json_particles(&c, root, &p, &n);

@@ -241,7 +241,8 @@ static veil_result set_names(const ctx* c, veil_scene* s)
 {
     const char* slash = strrchr(c->name, '/');
     s->path = dup_range(c->name, strlen(c->name));
-    if (!slash) s->base_dir = dup_range(".", 1);
+    if (c->base) s->base_dir = dup_range(c->base, strlen(c->base));
+    else if (!slash) s->base_dir = dup_range(".", 1);
     else s->base_dir = dup_range(c->name, slash == c->name ? 1 : (size_t)(slash - c->name));
     if (!s->path || !s->base_dir) return veil_fail(c->err, VEIL_ERR_OOM, "%s: out of memory", c->name);
     return VEIL_OK;
@@ -250,9 +251,16 @@ static veil_result set_names(const ctx* c, veil_scene* s)
 veil_result veil_scene_parse(const char* name, const char* json, size_t len,
                              veil_scene* out, veil_error* err)
 {
+    return veil_scene_parse_in(name, json, len, NULL, out, err);
+}
+
+veil_result veil_scene_parse_in(const char* name, const char* json, size_t len, const char* base_dir,
+                                veil_scene* out, veil_error* err)
+{
     if (!out || (!json && len)) return veil_fail(err, VEIL_ERR_INVALID, "veil_scene_parse: NULL argument");
     memset(out, 0, sizeof *out);
-    const ctx c = {name ? name : "<scene>", err};
+    if (base_dir && !base_dir[0]) base_dir = NULL; /* "": the name's folder, as for a file */
+    const ctx c = {name ? name : "<scene>", err, base_dir};
     if (!json) json = "";
     cJSON* root;
     TRY(parse_json(&c, json, len, &root));

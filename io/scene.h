@@ -24,4 +24,9 @@ veil_result veil_scene_load(const char* path, veil_scene* out, veil_error* err);
 veil_result veil_scene_parse(const char* name, const char* json, size_t len,
                              veil_scene* out, veil_error* err);
 
+/* Same, relative paths resolved against `base_dir` (NULL or "": name's
+ * folder, as veil_scene_parse), which becomes out->base_dir. */
+veil_result veil_scene_parse_in(const char* name, const char* json, size_t len, const char* base_dir,
+                                veil_scene* out, veil_error* err);
+
 #endif

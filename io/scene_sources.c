@@ -81,18 +81,22 @@ static veil_result get_string(const ctx* c, const cJSON* o, const jpath* pp, con
     return VEIL_OK;
 }
 
-/* `file` resolved against the folder of the scene file, and checked
- * readable (unless `unchecked`: a sequence's pattern, whose frames are
- * checked as they are needed). */
+/* `file` resolved against the scene's folder (c->base, else the scene
+ * file's), and checked readable (unless `unchecked`: a sequence's pattern,
+ * whose frames are checked as they are needed). */
 static veil_result resolve_path(const ctx* c, const jpath* fp, char** file, int unchecked)
 {
     const char* slash = strrchr(c->name, '/');
-    if ((*file)[0] != '/' && slash) {
-        size_t dir = (size_t)(slash - c->name) + 1, n = strlen(*file);
-        char* joined = malloc(dir + n + 1);
+    const char* base = c->base ? c->base : c->name;
+    size_t dir = c->base ? strlen(c->base) : slash ? (size_t)(slash - c->name) + 1 : 0;
+    if ((*file)[0] != '/' && dir > 0) {
+        const int sep = base[dir - 1] != '/'; /* a base folder given without its trailing slash */
+        size_t n = strlen(*file);
+        char* joined = malloc(dir + (size_t)sep + n + 1);
         if (!joined) return veil_fail(c->err, VEIL_ERR_OOM, "%s: out of memory", c->name);
-        memcpy(joined, c->name, dir);
-        memcpy(joined + dir, *file, n + 1);
+        memcpy(joined, base, dir);
+        if (sep) joined[dir] = '/';
+        memcpy(joined + dir + sep, *file, n + 1);
         free(*file);
         *file = joined;
     }

@@ -51,6 +51,48 @@ static void null_arguments(void)
     CHECK(strcmp(veil_result_name(VEIL_ERR_GPU), "VEIL_ERR_GPU") == 0, "result name");
 }
 
+/* veil_scene_from_json: a scene from text, its relative particle file
+ * found through base_dir (with or without a trailing slash), and not
+ * without it; errors start with the name given and name the field. Runs in
+ * the test's temporary folder (g_dir). */
+static void from_json(void)
+{
+    veil_error err = {{0}};
+    char particles[256];
+    path_in(particles, sizeof particles, "puffs.json");
+    FILE* f = fopen(particles, "w");
+    CHECK(f != NULL, "cannot write %s", particles);
+    if (!f) return;
+    fputs("{\"format\": \"veil-particles\", \"version\": 1, \"particles\": [\n"
+          "  {\"center\": [0, 0, 0], \"amplitude\": 1, \"sharpness\": 4}]}\n", f);
+    fclose(f);
+    const char* json = "{\"camera\": {\"position\": [0, 0, 3], \"look_at\": [0, 0, 0]},"
+                       " \"medium\": {\"sigma_a\": [0.1, 0.1, 0.1], \"sigma_s\": [1, 1, 1],"
+                       " \"sources\": [{\"type\": \"rbf\", \"file\": \"puffs.json\"}]},"
+                       " \"lights\": [{\"type\": \"directional\", \"direction\": [0, -1, 0], \"irradiance\": [1, 1, 1]}]}";
+    veil_scene* s = (veil_scene*)&err;
+    char slash[80];
+    snprintf(slash, sizeof slash, "%s/", g_dir);
+    CHECK(veil_scene_from_json(json, g_dir, "shot", &s, &err) == VEIL_OK && s, "base_dir %s: %s", g_dir, err.msg);
+    veil_scene_close(s);
+    s = NULL;
+    CHECK(veil_scene_from_json(json, slash, NULL, &s, &err) == VEIL_OK && s, "base_dir %s: %s", slash, err.msg);
+    veil_scene_close(s);
+    s = (veil_scene*)&err;
+    /* without the folder the file is looked for in the current one: not there */
+    CHECK(veil_scene_from_json(json, NULL, "shot", &s, &err) == VEIL_ERR_INVALID && s == NULL &&
+              strncmp(err.msg, "shot:", 5) == 0 && strstr(err.msg, "medium.sources[0].file") &&
+              strstr(err.msg, "puffs.json"),
+          "no base_dir: %s", err.msg);
+    CHECK(veil_scene_from_json("{\"camera\": ", g_dir, NULL, &s, &err) == VEIL_ERR_PARSE && s == NULL &&
+              strncmp(err.msg, "<json>", 6) == 0,
+          "bad JSON: %s", err.msg);
+    CHECK(veil_scene_from_json(NULL, g_dir, NULL, &s, &err) == VEIL_ERR_INVALID && s == NULL && strstr(err.msg, "json"),
+          "NULL json: %s", err.msg);
+    CHECK(veil_scene_from_json(json, g_dir, NULL, NULL, &err) == VEIL_ERR_INVALID, "NULL out");
+    remove(particles);
+}
+
 static veil_context* context_or_skip(void)
 {
     veil_context* ctx = NULL;
@@ -255,6 +297,7 @@ int main(int argc, char** argv)
     veil_error err = {{0}};
     CHECK(veil_scene_open(argv[1], &scene, &err) == VEIL_OK && scene, "open %s: %s", argv[1], err.msg);
     if (scene && test_dir_begin("api")) {
+        from_json();
         bad_descriptions(ctx, scene);
         render_and_read(ctx, scene);
         two_contexts(ctx, scene);
