@@ -154,6 +154,27 @@ veil_result veil_gl_compute_program(const char* file, const char* source, GLuint
     return VEIL_OK;
 }
 
+/* Immutable storage for a 3D or 2D array texture of dims (its limits
+ * checked by the caller), linear filtering, clamped to the edge. */
+static veil_result texture_storage(GLenum target, GLenum internal_format, const int dims[3], const char* label,
+                                   GLuint* out, veil_error* err)
+{
+    glCreateTextures(target, 1, out);
+    glTextureStorage3D(*out, 1, internal_format, dims[0], dims[1], dims[2]);
+    glTextureParameteri(*out, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(*out, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(*out, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(*out, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    if (target == GL_TEXTURE_3D) glTextureParameteri(*out, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    glObjectLabel(GL_TEXTURE, *out, -1, label);
+    veil_result r = veil_gl_check(label, err);
+    if (r != VEIL_OK) {
+        glDeleteTextures(1, out);
+        *out = 0;
+    }
+    return r;
+}
+
 veil_result veil_gl_texture3d(GLenum internal_format, const int dims[3], const char* label,
                               GLuint* out, veil_error* err)
 {
@@ -163,20 +184,7 @@ veil_result veil_gl_texture3d(GLenum internal_format, const int dims[3], const c
         if (dims[a] < 1 || dims[a] > max3d)
             return veil_fail(err, VEIL_ERR_LIMIT, "%s: %dx%dx%d voxels exceeds the GL limit of %d per side",
                              label, dims[0], dims[1], dims[2], max3d);
-    glCreateTextures(GL_TEXTURE_3D, 1, out);
-    glTextureStorage3D(*out, 1, internal_format, dims[0], dims[1], dims[2]);
-    glTextureParameteri(*out, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(*out, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(*out, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(*out, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(*out, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
-    glObjectLabel(GL_TEXTURE, *out, -1, label);
-    veil_result r = veil_gl_check(label, err);
-    if (r != VEIL_OK) {
-        glDeleteTextures(1, out);
-        *out = 0;
-    }
-    return r;
+    return texture_storage(GL_TEXTURE_3D, internal_format, dims, label, out, err);
 }
 
 veil_result veil_gl_texture2d_array(GLenum internal_format, const int dims[3], const char* label, GLuint* out,
@@ -188,19 +196,7 @@ veil_result veil_gl_texture2d_array(GLenum internal_format, const int dims[3], c
     if (dims[0] < 1 || dims[1] < 1 || dims[2] < 1 || dims[0] > max2d || dims[1] > max2d || dims[2] > layers)
         return veil_fail(err, VEIL_ERR_LIMIT, "%s: %dx%d texels, %d layers exceeds the GL limits (%d a side, %d layers)",
                          label, dims[0], dims[1], dims[2], max2d, layers);
-    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, out);
-    glTextureStorage3D(*out, 1, internal_format, dims[0], dims[1], dims[2]);
-    glTextureParameteri(*out, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(*out, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(*out, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(*out, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glObjectLabel(GL_TEXTURE, *out, -1, label);
-    veil_result r = veil_gl_check(label, err);
-    if (r != VEIL_OK) {
-        glDeleteTextures(1, out);
-        *out = 0;
-    }
-    return r;
+    return texture_storage(GL_TEXTURE_2D_ARRAY, internal_format, dims, label, out, err);
 }
 
 veil_result veil_gl_buffer(const void* data, size_t bytes, GLbitfield flags, const char* label,
