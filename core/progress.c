@@ -2,6 +2,8 @@
 
 static _Thread_local veil_progress_fn t_fn;
 static _Thread_local void* t_user;
+static _Thread_local const char* t_stage;
+static _Thread_local int t_cancelled;
 
 veil_progress_fn veil_progress_sink(veil_progress_fn fn, void* user, void** old_user)
 {
@@ -9,6 +11,7 @@ veil_progress_fn veil_progress_sink(veil_progress_fn fn, void* user, void** old_
     if (old_user) *old_user = t_user;
     t_fn = fn;
     t_user = user;
+    t_cancelled = 0;
     return old;
 }
 
@@ -18,3 +21,8 @@ void veil_progress(const char* what, double done, double total)
 {
     if (t_fn) t_fn(t_user, what, done, total);
 }
+
+void veil_progress_set_stage(const char* stage) { t_stage = stage; }
+const char* veil_progress_stage(void) { return t_stage; }
+void veil_progress_cancel(void) { t_cancelled = 1; }
+int veil_progress_cancelled(void) { return t_cancelled; }

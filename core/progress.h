@@ -17,4 +17,17 @@ veil_progress_fn veil_progress_sink(veil_progress_fn fn, void* user, void** old_
 int veil_progress_wanted(void);
 void veil_progress(const char* what, double done, double total);
 
+/* The stage the calling thread's render is in ("inject", ...: frame/stage.h's
+ * names), set by the renderer before each stage; NULL outside a render. */
+void veil_progress_set_stage(const char* stage);
+const char* veil_progress_stage(void);
+
+/* Cancelling (the public progress callback, include/veil.h): a sink calls
+ * veil_progress_cancel(); the pipeline tests veil_progress_cancelled()
+ * where it can stop cleanly (between stages, between the march's bands and
+ * the lights' optical-depth textures) and returns VEIL_ERR_CANCELLED.
+ * Installing a sink clears the flag. */
+void veil_progress_cancel(void);
+int veil_progress_cancelled(void);
+
 #endif

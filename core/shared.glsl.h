@@ -184,9 +184,9 @@ VEIL_STRUCT_END(veil_medium_block)
  * own settings, one std140 uniform block at VEIL_UBO_MARCH. */
 VEIL_STRUCT_BEGIN(veil_march_block)
     VEIL_V4(cam_pos);      /* xyz: camera position (m) */
-    VEIL_V4(cam_fwd);      /* xyz: unit view direction */
-    VEIL_V4(cam_right);    /* xyz: right, scaled by tan(fov/2) and the aspect */
-    VEIL_V4(cam_up);       /* xyz: up, scaled by tan(fov/2) */
+    VEIL_V4(cam_fwd);      /* xyz: the image centre's direction (the view direction, moved by the lens shift) */
+    VEIL_V4(cam_right);    /* xyz: right, scaled by tan(fov_x/2); w: the near clip distance along the view axis (m) */
+    VEIL_V4(cam_up);       /* xyz: up, scaled by tan(fov_y/2); w: the far clip distance (m; FLT_MAX: none) */
     VEIL_V4(background);   /* rgb: radiance behind the medium */
     VEIL_V4(march);        /* x: step (m); the cache's gather (render/shaders/cache_gather.comp): y its rays a cell (0: off),
                               z its steps in the cache's cells, w the cache's cells a side of one of its cells

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/progress.h"
 #include "../core/result.h"
 #include "../gpu/gl_context.h"
 #include "../io/image.h"
@@ -70,12 +71,35 @@ typedef struct render_desc_0_2 {
     uint32_t seed;
     long frame, frames;
 } render_desc_0_2;
-#define RENDER_DESC_NEWEST render_desc_0_2
-static const veil__desc_layout render_desc_releases[] = {VEIL__DESC_LAYOUT(render_desc_0_2, frames)};
+typedef struct render_desc_0_3 {
+    size_t size;
+    int width, height;
+    float step_voxels;
+    uint32_t seed;
+    long frame, frames;
+    veil_progress_callback progress;
+    void* progress_user;
+} render_desc_0_3;
+#define RENDER_DESC_NEWEST render_desc_0_3
+static const veil__desc_layout render_desc_releases[] = {VEIL__DESC_LAYOUT(render_desc_0_2, frames),
+                                                         VEIL__DESC_LAYOUT(render_desc_0_3, progress_user)};
 static const veil__desc_layouts render_desc_layouts = {"veil_render", "veil_render_desc", render_desc_releases,
                                                        VEIL__COUNT(render_desc_releases)};
 _Static_assert(sizeof(veil_render_desc) == sizeof(RENDER_DESC_NEWEST),
                "veil_render_desc changed: freeze its new layout above");
+
+typedef struct grid_desc_0_3 {
+    size_t size;
+    const float* data;
+    int dims[3];
+    int axis_order;
+    double index_to_world[16];
+} grid_desc_0_3;
+#define GRID_DESC_NEWEST grid_desc_0_3
+static const veil__desc_layout grid_desc_releases[] = {VEIL__DESC_LAYOUT(grid_desc_0_3, index_to_world)};
+static const veil__desc_layouts grid_desc_layouts = {"veil_scene_set_grid", "veil_grid_desc", grid_desc_releases,
+                                                     VEIL__COUNT(grid_desc_releases)};
+_Static_assert(sizeof(veil_grid_desc) == sizeof(GRID_DESC_NEWEST), "veil_grid_desc changed: freeze its new layout above");
 
 /* ---- context ------------------------------------------------------------- */
 
@@ -144,6 +168,28 @@ veil_result veil_scene_from_json(const char* json, const char* base_dir, const c
     return VEIL_OK;
 }
 
+veil_result veil_scene_set_grid(veil_scene* scene, const char* name, const veil_grid_desc* grid, veil_error* err)
+{
+    if (!scene) return VEIL__NULL_ARG("veil_scene_set_grid", "scene");
+    if (!name) return VEIL__NULL_ARG("veil_scene_set_grid", "name");
+    if (!grid) return VEIL__NULL_ARG("veil_scene_set_grid", "grid");
+    veil_grid_desc d;
+    veil_result r = veil__desc_read(&grid_desc_layouts, grid, &d, err);
+    if (r != VEIL_OK) return r;
+    if (!d.data) return VEIL__NULL_ARG("veil_scene_set_grid", "grid->data");
+    if (d.axis_order != VEIL_AXIS_ORDER_X_FASTEST && d.axis_order != VEIL_AXIS_ORDER_Z_FASTEST)
+        return veil_fail(err, VEIL_ERR_INVALID, "veil_scene_set_grid: grid '%.200s': axis_order %d is neither "
+                         "VEIL_AXIS_ORDER_X_FASTEST (0) nor VEIL_AXIS_ORDER_Z_FASTEST (1)", name, d.axis_order);
+    double m[4][4];
+    int zero = 1;
+    for (int i = 0; i < 16; ++i) zero &= d.index_to_world[i] == 0.0;
+    for (int i = 0; i < 16; ++i) m[i / 4][i % 4] = zero ? (i % 5 == 0 ? 1.0 : 0.0) : d.index_to_world[i];
+    veil_error inner = {{0}};
+    r = veil_scene_grid_set(scene, name, d.data, d.dims, d.axis_order == VEIL_AXIS_ORDER_Z_FASTEST, m, &inner);
+    if (r != VEIL_OK) return veil_fail(err, r, "veil_scene_set_grid: %.1900s", inner.msg);
+    return VEIL_OK;
+}
+
 void veil_scene_close(veil_scene* scene)
 {
     if (!scene) return;
@@ -170,6 +216,33 @@ static veil_result check_render_desc(const veil_render_desc* d, veil_error* err)
     return VEIL_OK;
 }
 
+/* The caller's progress callback behind the pipeline's progress sink
+ * (core/progress.h): the internal reports ("march, rows", 120 of 480) become
+ * the stage's share done; a stage's end is reported as 1 when the next
+ * begins (and the last when the render returns). */
+typedef struct api_progress {
+    veil_progress_callback fn;
+    void* user;
+    const char* stage; /* the stage last reported */
+} api_progress;
+
+static void api_progress_tell(api_progress* p, const char* stage, double done)
+{
+    if (p->fn(p->user, stage, done)) veil_progress_cancel();
+}
+
+static void api_progress_sink(void* user, const char* what, double done, double total)
+{
+    (void)what;
+    api_progress* p = user;
+    const char* stage = veil_progress_stage();
+    if (!stage) return;
+    if (p->stage && p->stage != stage) api_progress_tell(p, p->stage, 1.0);
+    p->stage = stage;
+    double share = total > 0.0 ? done / total : 0.0;
+    api_progress_tell(p, stage, share < 0.0 ? 0.0 : share > 1.0 ? 1.0 : share);
+}
+
 veil_result veil_render(veil_context* ctx, const veil_scene* scene, const veil_render_desc* desc, veil_image** out,
                         veil_error* err)
 {
@@ -189,7 +262,16 @@ veil_result veil_render(veil_context* ctx, const veil_scene* scene, const veil_r
     veil_camera cam = veil_camera_of_frame(&scene->camera, d.frame, d.frames);
     veil_render_opts opts = {.width = d.width, .height = d.height, .step_voxels = d.step_voxels,
                              .seed = d.seed, .camera = &cam};
+    api_progress prog = {d.progress, d.progress_user, NULL};
+    void* old_user = NULL;
+    veil_progress_fn old = d.progress ? veil_progress_sink(api_progress_sink, &prog, &old_user) : NULL;
     r = veil_render_scene_images(ctx->renderer, scene, &opts, &img->set, &img->stats, err);
+    if (d.progress) {
+        if (r == VEIL_OK && prog.stage) api_progress_tell(&prog, prog.stage, 1.0);
+        if (r == VEIL_OK && veil_progress_cancelled()) /* asked for by the last report: nothing is returned */
+            r = veil_fail(err, VEIL_ERR_CANCELLED, "cancelled by the progress callback as the render ended");
+        veil_progress_sink(old, old_user, NULL);
+    }
     if (r != VEIL_OK) {
         veil_image_destroy(img);
         return r;

@@ -144,7 +144,8 @@ void veil_frame_plan_volume(veil_frame_plan* p, const veil_grid* g, int sparse, 
     p->glows = 0;
     for (size_t i = 0; g && i < p->scene->medium.source_count; ++i) {
         const veil_source* src = &p->scene->medium.sources[i];
-        p->glows |= src->type == VEIL_SOURCE_VDB && (src->vdb.emission_grid || src->vdb.temperature_grid);
+        p->glows |= (src->type == VEIL_SOURCE_VDB || src->type == VEIL_SOURCE_ARRAY) &&
+                    (src->vdb.emission_grid || src->vdb.temperature_grid);
     }
     if (cache) n_emission = 0;
     /* the medium's emission as lights (volume/emission_lights.h): after the scene's, while there is room */

@@ -104,6 +104,12 @@ static veil_result run_frame(veil_renderer* r, veil_frame* f, veil_render_stats*
         const veil_stage_row* row = &veil_stage_table[i];
         veil_stage_report* rep = &st->stage[row->id];
         double t0 = veil_now_ms(), gpu0 = f->gpu_ms;
+        if (veil_progress_cancelled()) { /* the caller's progress callback asked to stop: between stages */
+            res = veil_fail(err, VEIL_ERR_CANCELLED, "cancelled by the progress callback before the %s stage",
+                            veil_stage_name(row->id));
+            break;
+        }
+        veil_progress_set_stage(veil_stage_name(row->id));
         veil_progress(row->doing, 0, 1);
         rep->key = row->key(&f->plan);
         int kept = !row->per_view && r->parts.has[row->id] && r->parts.kept[row->id] == rep->key;
@@ -115,6 +121,7 @@ static veil_result run_frame(veil_renderer* r, veil_frame* f, veil_render_stats*
         if (r->ready) glFinish();
         rep->ms = veil_now_ms() - t0 - (f->gpu_ms - gpu0);
     }
+    veil_progress_set_stage(NULL);
     veil_frame_end(f);
     st->inject_ms = st->stage[VEIL_STAGE_INJECT].ms;
     st->propagate_ms = st->stage[VEIL_STAGE_PROPAGATE].ms;

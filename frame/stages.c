@@ -14,6 +14,7 @@
 #include "../propagate/opv_set.h"
 #include "../render/march.h"
 #include "../render/spread.h"
+#include "../scene/camera.h"
 #include "../volume/ev.h"
 #include "../volume/scene_volume.h"
 
@@ -577,6 +578,15 @@ static veil_stage_status spread_decide(const veil_frame_plan* p, int kept, char*
     return VEIL_STAGE_RAN;
 }
 
+/* The vertical field of view of a width x height image (the camera's fov spans the side its sensor fit names):
+ * the spread's pixel footprint. */
+static float vertical_fov_deg(const veil_camera* c, int width, int height)
+{
+    double tx, ty;
+    veil_camera_tan_half(c, width, height, &tx, &ty);
+    return (float)(atan(ty) * 360.0 / VEIL_PI);
+}
+
 static veil_result spread_build(veil_frame* f, veil_stage_report* rep, veil_error* err)
 {
     const veil_frame_plan* p = &f->plan;
@@ -595,7 +605,7 @@ static veil_result spread_build(veil_frame* f, veil_stage_report* rep, veil_erro
     im->aov_m = malloc(floats * sizeof(float));
     if (!im->aov_m) return veil_fail(err, VEIL_ERR_OOM, "out of memory for the spread image");
     veil_spread_input in = {.width = im->width, .height = im->height, .L = o->behind, .background = {0, 0, 0},
-                            .aov_t = im->aov_t, .aov_s = im->aov_s, .aov_q = q, .fov_y_deg = o->camera->fov_y_deg};
+                            .aov_t = im->aov_t, .aov_s = im->aov_s, .aov_q = q, .fov_y_deg = vertical_fov_deg(o->camera, im->width, im->height)};
     veil_spread_report sr = {0};
     veil_result res = veil_spread_run(f->parts->spread, s, &in, im->aov_m, NULL, &sr, err);
     if (res != VEIL_OK) return res;

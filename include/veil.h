@@ -59,14 +59,14 @@
 /* This header's version (CMakeLists.txt reads the project's version from
  * these three lines). */
 #define VEIL_VERSION_MAJOR 0
-#define VEIL_VERSION_MINOR 2
+#define VEIL_VERSION_MINOR 3
 #define VEIL_VERSION_PATCH 0
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* The loaded library's version: "0.2.0". */
+/* The loaded library's version: "0.3.0". */
 VEIL_API const char* veil_version(void);
 
 /* The loaded library's version as numbers (each output may be NULL). */
@@ -113,9 +113,58 @@ VEIL_API veil_result veil_scene_from_json(const char* json, const char* base_dir
                                           veil_error* err);
 VEIL_API void veil_scene_close(veil_scene* scene); /* accepts NULL */
 
+/* ---- grids from memory (veil 0.3) ---------------------------------------- */
+
+/* How a grid's values lie in memory. */
+typedef enum veil_axis_order {
+    VEIL_AXIS_ORDER_X_FASTEST = 0, /* value(i, j, k) = data[i + nx * (j + ny * k)] (OpenVDB's LayoutXYZ,
+                                      a Fortran-ordered array a[i, j, k]) */
+    VEIL_AXIS_ORDER_Z_FASTEST = 1  /* value(i, j, k) = data[k + nz * (j + ny * i)] (a C array float a[nx][ny][nz],
+                                      a C-ordered numpy array indexed [i, j, k], as pyopenvdb's copyFromArray) */
+} veil_axis_order;
+
+/* A dense float grid: the value of index (i, j, k), 0 <= i < dims[0] etc.,
+ * is a sample at world index_to_world * (i, j, k, 1), as a VDB file's voxel
+ * (docs/scene-format.md, "vdb"): voxel centres at integer indices, the
+ * field between them trilinear, values of 0 empty space. */
+typedef struct veil_grid_desc {
+    size_t size;               /* sizeof(veil_grid_desc), or 0: veil 0.3's layout */
+    const float* data;         /* dims[0] * dims[1] * dims[2] floats, in axis_order */
+    int dims[3];               /* nx, ny, nz, each >= 1, their product <= 2^30 */
+    int axis_order;            /* veil_axis_order */
+    double index_to_world[16]; /* row-major 4x4 acting on column vectors (i, j, k, 1), last row 0 0 0 1,
+                                  invertible; all zero: the identity (1 m voxels, index (0,0,0) at the origin) */
+} veil_grid_desc;
+
+#ifdef __cplusplus
+#define VEIL_GRID_DESC_INIT {sizeof(veil_grid_desc), nullptr, {0, 0, 0}, 0, {0}}
+#else
+#define VEIL_GRID_DESC_INIT {.size = sizeof(veil_grid_desc)}
+#endif
+
+/* Copies grid into scene under `name`, replacing a grid of that name: the
+ * scene's "array" sources that name it (their "grid", or their emission or
+ * temperature "grid") read it. veil keeps its own copy: the caller's
+ * buffer may go once this returns. VEIL_ERR_INVALID for a bad dimension,
+ * axis order or matrix, or a value that is not finite (NaN, infinite),
+ * VEIL_ERR_LIMIT over 2^30 values. A source naming a
+ * grid never given fails veil_render with VEIL_ERR_INVALID and the
+ * source's JSON path. */
+VEIL_API veil_result veil_scene_set_grid(veil_scene* scene, const char* name, const veil_grid_desc* grid,
+                                         veil_error* err);
+
 /* ---- render ------------------------------------------------------------ */
 
 typedef struct veil_image veil_image;
+
+/* Progress (veil 0.3): called on the rendering thread as the work goes on,
+ * with the stage ("inject", "propagate", "volumetric", "render" or
+ * "spread") and the share of it done, 0..1. Return 0 to go on; any other
+ * value cancels the render: veil_render then returns VEIL_ERR_CANCELLED as
+ * soon as the work in flight ends (between stages, between bands of rows
+ * of the march) and makes no image. The stages a cancelled render did finish
+ * stay cached in the context. */
+typedef int (*veil_progress_callback)(void* user, const char* stage, double done);
 
 /* Zero means default in every field but size. */
 typedef struct veil_render_desc {
@@ -127,10 +176,12 @@ typedef struct veil_render_desc {
                            turn about the camera's up axis through its look-at point in
                            `frames` equal steps (frame 0: the scene's camera);
                            0 or 1: the scene's camera (frame must be 0) */
+    veil_progress_callback progress; /* veil 0.3; NULL: none */
+    void* progress_user;             /* passed to progress */
 } veil_render_desc;
 
 #ifdef __cplusplus
-#define VEIL_RENDER_DESC_INIT {sizeof(veil_render_desc), 0, 0, 0.0f, 0u, 0L, 0L}
+#define VEIL_RENDER_DESC_INIT {sizeof(veil_render_desc), 0, 0, 0.0f, 0u, 0L, 0L, nullptr, nullptr}
 #else
 #define VEIL_RENDER_DESC_INIT {.size = sizeof(veil_render_desc)}
 #endif
@@ -150,7 +201,10 @@ VEIL_API const float* veil_image_rgba(const veil_image* img);
 /* One channel as a width*height plane into out (the caller's). Names:
  * "R", "G", "B", "A", "T.R", "T.G", "T.B" (transmittance), "P" (density
  * integral), "single.R", "single.G", "single.B" (single scattering),
- * "depth" (mean distance of the first interaction, m). VEIL_ERR_INVALID
+ * "depth" (mean distance of the first interaction, m),
+ * "multiple.volume.R", ".G", ".B" (the volumetric multiple-scattering
+ * estimate), "multiple.screen.R", ".G", ".B" (the screen-space spread);
+ * R, G, B = T * background + single + multiple.volume + multiple.screen. VEIL_ERR_INVALID
  * for any other name. */
 VEIL_API veil_result veil_image_channel(const veil_image* img, const char* name, float* out, veil_error* err);
 

@@ -22,7 +22,9 @@
 static const char* const ROOT_KEYS[] = {"camera", "medium", "lights", "background", "multiple_scattering", "quality",
                                         NULL};
 static const char* const QUALITIES[] = {"draft", "default", "high", "max", NULL}; /* = veil_quality - 1 */
-static const char* const CAMERA_KEYS[] = {"position", "look_at", "up", "fov_y_deg", "width", "height", NULL};
+static const char* const CAMERA_KEYS[] = {"position", "look_at", "up", "fov_y_deg", "fov_deg", "sensor_fit", "shift",
+                                          "clip", "width", "height", NULL};
+static const char* const SENSOR_FITS[] = {"vertical", "horizontal", "auto", NULL}; /* = veil_sensor_fit */
 static const char* const MEDIUM_KEYS[] = {"sigma_a", "sigma_s", "phase", "max_resolution", "representation",
                                            "sources", NULL};
 static const char* const REPRESENTATIONS[] = {"auto", "dense", "sparse", NULL}; /* = veil_representation */
@@ -65,8 +67,35 @@ static veil_result parse_camera(const ctx* c, const cJSON* root, veil_camera* ca
     TRY(veil__jr_get_floats_in(c, o, &p, "position", true, 3, &VEIL__R_COORD, cam->position));
     TRY(veil__jr_get_floats_in(c, o, &p, "look_at", true, 3, &VEIL__R_COORD, cam->look_at));
     TRY(veil__jr_get_floats(c, o, &p, "up", false, 3, false, cam->up));
-    TRY(veil__jr_get_number(c, o, &p, "fov_y_deg", false, &VEIL__R_FOV, &fov));
+    /* the field of view: "fov_y_deg" (vertical), or "fov_deg" along "sensor_fit" */
+    const jpath fp = {&p, "sensor_fit", 0};
+    const cJSON* fit = cJSON_GetObjectItemCaseSensitive(o, "sensor_fit");
+    if (fit) {
+        int k = -1;
+        for (int i = 0; fit && cJSON_IsString(fit) && SENSOR_FITS[i]; ++i)
+            if (!strcmp(fit->valuestring, SENSOR_FITS[i])) k = i;
+        if (k < 0) return veil__jr_expected(c, &fp, "one of \"vertical\", \"horizontal\", \"auto\"", fit);
+        cam->sensor_fit = k;
+    }
+    const int y_given = cJSON_GetObjectItemCaseSensitive(o, "fov_y_deg") != NULL;
+    if (y_given && cJSON_GetObjectItemCaseSensitive(o, "fov_deg"))
+        return veil__jr_fail_at(c, &(jpath){&p, "fov_deg", 0}, "give either \"fov_y_deg\" (vertical) or "
+                                "\"fov_deg\" (along sensor_fit), not both");
+    if (y_given && cam->sensor_fit != VEIL_FIT_VERTICAL)
+        return veil__jr_fail_at(c, &(jpath){&p, "fov_y_deg", 0}, "is the vertical field of view: with sensor_fit "
+                                "\"%s\" give \"fov_deg\" instead", SENSOR_FITS[cam->sensor_fit]);
+    TRY(veil__jr_get_number(c, o, &p, y_given ? "fov_y_deg" : "fov_deg", false, &VEIL__R_FOV, &fov));
     cam->fov_y_deg = (float)fov;
+    /* Blender's shift: fractions of the fitted side's extent; within +-100 of it, the rays stay finite */
+    static const range shift = {-100, 100, false, false, false, "a number in [-100, 100] (the image's fitted side)"};
+    TRY(veil__jr_get_floats_in(c, o, &p, "shift", false, 2, &shift, cam->shift));
+    const jpath cp = {&p, "clip", 0};
+    if (cJSON_GetObjectItemCaseSensitive(o, "clip")) {
+        TRY(veil__jr_get_floats_in(c, o, &p, "clip", false, 2, &VEIL__R_COORD, cam->clip));
+        if (!(cam->clip[0] >= 0.0f && cam->clip[1] > cam->clip[0]))
+            return veil__jr_fail_at(c, &cp, "expected [near, far] with 0 <= near < far (m along the view axis), "
+                                    "got [%g, %g]", cam->clip[0], cam->clip[1]);
+    }
     TRY(veil__jr_get_int(c, o, &p, "width", &VEIL__R_SIZE, &cam->width));
     TRY(veil__jr_get_int(c, o, &p, "height", &VEIL__R_SIZE, &cam->height));
     TRY(check_camera(c, &p, cam));

@@ -13,9 +13,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char* const SOURCE_TYPES[] = {"rbf", "rbf_random", "vdb", "exponential", NULL}; /* = veil_source_type */
+static const char* const SOURCE_TYPES[] = {"rbf", "rbf_random", "vdb", "exponential", "array", NULL}; /* = veil_source_type */
 static const char* const VDB_KEYS[] = {"type", "file", "grid", "density_scale", "level_set", "emission", "temperature",
-                                       "frame_offset", NULL};
+                                       "frame_offset", "transform", NULL};
+static const char* const ARRAY_KEYS[] = {"type", "grid", "density_scale", "emission", "temperature", "transform", NULL};
 static const char* const TEMPERATURE_KEYS[] = {"grid", "scale", "offset", "intensity", NULL};
 static const char* const EMISSION_KEYS[] = {"grid", "scale", "color", NULL};
 static const char* const FOG_KEYS[] = {"type", "density", "falloff", "direction", "origin", "bounds", NULL};
@@ -140,9 +141,42 @@ static veil_result parse_rbf(const ctx* c, const cJSON* so, const jpath* sp, vei
     return r;
 }
 
+/* "transform": 4 rows of 4 numbers, an affine map (last row 0 0 0 1) with an invertible 3x3 part. */
+static veil_result parse_transform(const ctx* c, const cJSON* so, const jpath* sp, veil_vdb_source* v)
+{
+    static const char what[] = "an array of 4 rows of 4 numbers (a 4x4 matrix acting on column vectors, last row "
+                               "0 0 0 1)";
+    const jpath p = {sp, "transform", 0};
+    const cJSON* t;
+    TRY(veil__jr_lookup(c, so, &p, false, what, &t));
+    if (!t) return VEIL_OK;
+    if (!cJSON_IsArray(t) || cJSON_GetArraySize(t) != 4) return veil__jr_expected(c, &p, what, t);
+    double(*m)[4] = v->transform;
+    for (int r = 0; r < 4; ++r) {
+        const jpath rp = {&p, NULL, (size_t)r};
+        float row[4];
+        TRY(veil__jr_parse_floats_in(c, cJSON_GetArrayItem(t, r), &rp, 4, &VEIL__R_COORD, row));
+        /* the numbers as written (parse_floats_in checks them; the values are read again as doubles) */
+        const cJSON* e;
+        int k = 0;
+        cJSON_ArrayForEach(e, cJSON_GetArrayItem(t, r)) m[r][k++] = e->valuedouble;
+    }
+    double det;
+    int affine = veil_affine_check((const double(*)[4])m, &det);
+    if (affine < 0)
+        return veil__jr_fail_at(c, &(jpath){&p, NULL, 3}, "expected [0, 0, 0, 1] (veil takes affine maps), got "
+                                "[%g, %g, %g, %g]", m[3][0], m[3][1], m[3][2], m[3][3]);
+    if (affine == 0)
+        return veil__jr_fail_at(c, &p, "the matrix is singular (determinant %g): a voxel would have no volume", det);
+    v->has_transform = 1;
+    return VEIL_OK;
+}
+
+static veil_result parse_grids(const ctx* c, const cJSON* so, const jpath* sp, veil_vdb_source* v, int array);
+
 static veil_result parse_vdb(const ctx* c, const cJSON* so, const jpath* sp, veil_vdb_source* v)
 {
-    const jpath fp = {sp, "file", 0}, lp = {sp, "level_set", 0};
+    const jpath fp = {sp, "file", 0};
     TRY(get_string(c, so, sp, "file", true, &v->file));
     int kind = veil_frame_pattern_kind(v->file);
     if (kind < 0)
@@ -170,7 +204,21 @@ static veil_result parse_vdb(const ctx* c, const cJSON* so, const jpath* sp, vei
             return veil__jr_fail_at(c, &(jpath){sp, "frame_offset", 0}, "only for a sequence (a file with #### or %%04d)");
         TRY(resolve_file(c, &fp, &v->file));
     }
-    TRY(get_string(c, so, sp, "grid", false, &v->grid));
+    return parse_grids(c, so, sp, v, 0);
+}
+
+/* An "array" source: a vdb source's grids without a file, from veil_scene_set_grid. */
+static veil_result parse_array(const ctx* c, const cJSON* so, const jpath* sp, veil_vdb_source* v)
+{
+    return parse_grids(c, so, sp, v, 1);
+}
+
+/* What a vdb and an array source share: the grids, their scales and the transform. */
+static veil_result parse_grids(const ctx* c, const cJSON* so, const jpath* sp, veil_vdb_source* v, int array)
+{
+    const jpath lp = {sp, "level_set", 0};
+    TRY(get_string(c, so, sp, "grid", array != 0, &v->grid));
+    TRY(parse_transform(c, so, sp, v));
     double scale = 1.0;
     TRY(veil__jr_get_number(c, so, sp, "density_scale", false, &VEIL__R_DENSITY, &scale));
     v->density_scale = (float)scale;
@@ -245,7 +293,7 @@ static veil_result parse_fog(const ctx* c, const cJSON* so, const jpath* sp, vei
 
 veil_result veil__parse_sources(const ctx* c, const cJSON* medium, const jpath* mp, veil_medium* m)
 {
-    static const char* const* const keys[] = {RBF_KEYS, RANDOM_KEYS, VDB_KEYS, FOG_KEYS}; /* by type */
+    static const char* const* const keys[] = {RBF_KEYS, RANDOM_KEYS, VDB_KEYS, FOG_KEYS, ARRAY_KEYS}; /* by type */
     const jpath p = {mp, "sources", 0};
     const cJSON* arr, *e;
     size_t i = 0, fogs = 0;
@@ -265,6 +313,7 @@ veil_result veil__parse_sources(const ctx* c, const cJSON* medium, const jpath* 
         case VEIL_SOURCE_RBF: TRY(parse_rbf(c, e, &ep, src)); break;
         case VEIL_SOURCE_RBF_RANDOM: TRY(parse_random(c, e, &ep, &src->random)); break;
         case VEIL_SOURCE_VDB: TRY(parse_vdb(c, e, &ep, &src->vdb)); break;
+        case VEIL_SOURCE_ARRAY: TRY(parse_array(c, e, &ep, &src->vdb)); break;
         case VEIL_SOURCE_EXPONENTIAL:
             if (++fogs > VEIL_MAX_FOGS)
                 return veil__jr_fail_at(c, &ep, "at most %d exponential fogs are supported", VEIL_MAX_FOGS);

@@ -23,6 +23,7 @@
 
 #include <openvdb/openvdb.h>
 #include <openvdb/io/File.h>
+#include <openvdb/tools/Dense.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetUtil.h>
 #include <nanovdb/util/IO.h>
@@ -489,6 +490,32 @@ void fill_info(const std::string& path, openvdb::io::File* file, const GridBase&
     }
 }
 
+// Gives grid the index-to-world map m (column vectors, last row 0 0 0 1),
+// refusing a singular or non-finite one (the reader and the resampler
+// invert it).
+void place(FloatGrid& grid, const double m[4][4], const char* label)
+{
+    openvdb::Mat4d a; // row vectors: world = idx * a, so a is m transposed
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) {
+            if (!std::isfinite(m[r][c])) fail_with(VEIL_ERR_INVALID, std::string(label) + ": the index-to-world matrix "
+                                                   "holds a value that is not finite");
+            a(c, r) = m[r][c];
+        }
+    if (m[3][0] != 0.0 || m[3][1] != 0.0 || m[3][2] != 0.0 || m[3][3] != 1.0)
+        fail_with(VEIL_ERR_INVALID, std::string(label) + ": the index-to-world matrix's last row is not 0 0 0 1 "
+                                                         "(veil takes affine maps)");
+    const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                       m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                       m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    double scale = 0.0; // the largest column length: a det below 1e-12 scale^3 is singular at double precision
+    for (int c = 0; c < 3; ++c) scale = std::max(scale, std::sqrt(m[0][c] * m[0][c] + m[1][c] * m[1][c] + m[2][c] * m[2][c]));
+    if (!(std::fabs(det) > 1e-12 * scale * scale * scale))
+        fail_with(VEIL_ERR_INVALID, std::string(label) + ": the index-to-world matrix is singular (determinant " +
+                                        std::to_string(det) + "): a voxel would have no volume");
+    grid.setTransform(openvdb::math::Transform::createLinearTransform(a));
+}
+
 cJSON* json_ints(const int v[3])
 {
     return cJSON_CreateIntArray(v, 3);
@@ -783,6 +810,59 @@ veil_result veil_vdb_info_json(const char* path, char** json_out, veil_error* er
     veil_vdb_file_info_free(grids, n);
     if (!*json_out) return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory while writing the grid summary", path);
     return VEIL_OK;
+}
+
+
+veil_result veil_vdb_from_dense(const char* label, const char* name, const float* data, const int dims[3],
+                                int z_fastest, const double index_to_world[4][4], veil_vdb** out, veil_error* err)
+{
+    if (out) *out = nullptr;
+    if (!label || !name || !data || !dims || !index_to_world || !out)
+        return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_from_dense: missing argument");
+    for (int a = 0; a < 3; ++a)
+        if (dims[a] < 1) return veil_fail(err, VEIL_ERR_INVALID, "%s: dimension %d is %d (at least 1)", label, a, dims[a]);
+    veil_vdb* v = nullptr;
+    return guarded(err, label, [&] {
+        init_openvdb();
+        const CoordBBox box(Coord(0, 0, 0), Coord(dims[0] - 1, dims[1] - 1, dims[2] - 1));
+        FloatGrid::Ptr grid = FloatGrid::create(0.0f);
+        float* values = const_cast<float*>(data); // Dense wants a mutable pointer; copyFromDense only reads it
+        if (z_fastest) {
+            openvdb::tools::Dense<float, openvdb::tools::LayoutZYX> dense(box, values);
+            openvdb::tools::copyFromDense(dense, *grid, 0.0f);
+        } else {
+            openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, values);
+            openvdb::tools::copyFromDense(dense, *grid, 0.0f);
+        }
+        grid->setName(name);
+        grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+        place(*grid, index_to_world, label);
+        const std::string where = std::string(label) + ": grid " + quoted(name);
+        const veil_vdb_values values_range = scan_values(*grid, where);
+        v = new veil_vdb{label, name, grid, grid->evalActiveVoxelBoundingBox(), grid->activeVoxelCount(), "",
+                         values_range};
+        *out = v;
+    });
+}
+
+veil_result veil_vdb_place(veil_vdb* v, const double m[4][4], veil_error* err)
+{
+    if (!v || !m) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_place: missing argument");
+    return guarded(err, v->path.c_str(), [&] {
+        const openvdb::math::Transform& t = v->grid->transform();
+        if (!t.baseMap()->isLinear())
+            fail_with(VEIL_ERR_INVALID, v->path + ": grid " + ("'" + v->name + "'") + " has a non-affine transform (" +
+                                            t.baseMap()->type() + "); a source's \"transform\" needs an affine one");
+        double own[4][4], c[4][4];
+        to_column_matrix(t, own);
+        for (int r = 0; r < 4; ++r)
+            for (int k = 0; k < 4; ++k) {
+                double s = 0.0;
+                for (int j = 0; j < 4; ++j) s += m[r][j] * own[j][k];
+                c[r][k] = s;
+            }
+        place(*v->grid, c, v->path.c_str());
+    });
 }
 
 } // extern "C"

@@ -56,6 +56,24 @@ veil_result veil_vdb_open(const char* path, const char* grid_name, int level_set
 /* Accepts NULL. */
 void veil_vdb_close(veil_vdb* v);
 
+/* A grid made from memory (an "array" source): dims[0] x dims[1] x dims[2]
+ * values, x fastest (data[i + nx (j + ny k)]) or, with z_fastest, z fastest
+ * (data[k + nz (j + ny i)], a C array indexed [i][j][k]); the value of index
+ * (i, j, k) lies at index_to_world (column vectors) times (i, j, k, 1), as a
+ * file's voxel does. Values of 0 are inactive, as in a file written by
+ * pyopenvdb's copyFromArray (openvdb::tools::copyFromDense, tolerance 0):
+ * both give the same tree. `label` stands for the file in messages and
+ * veil_vdb_path. The values are copied; NaN or infinite values are refused
+ * as veil_vdb_open refuses them, and so is a singular or non-affine matrix
+ * (VEIL_ERR_INVALID). */
+veil_result veil_vdb_from_dense(const char* label, const char* name, const float* data, const int dims[3],
+                                int z_fastest, const double index_to_world[4][4], veil_vdb** out, veil_error* err);
+
+/* Places v in a world: its index-to-world map becomes m x (its own map)
+ * (column vectors; m affine and invertible, else VEIL_ERR_INVALID). Called
+ * once, right after opening, before v is shared. */
+veil_result veil_vdb_place(veil_vdb* v, const double m[4][4], veil_error* err);
+
 /* From now on, reading a file (veil_vdb_open, veil_vdb_file_info) limits
  * the process's address space for the time of the read to what it uses
  * plus 1 GiB plus 64 times the file's size (setrlimit, restored after):

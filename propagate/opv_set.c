@@ -444,6 +444,11 @@ veil_result veil_opv_set_update(veil_opv_set* s, const veil_grid* g, GLuint ev, 
         if (report) { /* lights done of all; the textures before this one finished first */
             glFinish();
             veil_progress("optical depth, lights", 4.0 * t, n);
+            if (veil_progress_cancelled()) { /* the textures made so far keep their keys */
+                r = veil_fail(err, VEIL_ERR_CANCELLED, "cancelled by the progress callback during the optical "
+                              "depth (%d of %d lights done)", 4 * t, n);
+                break;
+            }
         }
         int count = n - 4 * t < 4 ? n - 4 * t : 4, on_grid = 0;
         for (int c = 0; c < count; ++c) on_grid += !ol[4 * t + c].elsewhere;

@@ -438,6 +438,9 @@ veil_result veil_pt_render(const veil_pt_medium* m, const veil_scene* s, const v
     int w = opts->width > 0 ? opts->width : cam->width, h = opts->height > 0 ? opts->height : cam->height;
     if (w < 1 || h < 1 || w > VEIL_SCENE_MAX_IMAGE || h > VEIL_SCENE_MAX_IMAGE)
         return veil_fail(err, VEIL_ERR_INVALID, "image size %dx%d is outside 1..%d", w, h, VEIL_SCENE_MAX_IMAGE);
+    if (cam->clip[0] > 0.0f || cam->clip[1] > 0.0f) /* the camera walk starts at the eye and never ends early */
+        return veil_fail(err, VEIL_ERR_INVALID, "camera.clip: the reference path tracer has no clip planes (the "
+                         "march has); remove camera.clip to compare with it");
     if (opts->spp < 2) return veil_fail(err, VEIL_ERR_INVALID, "spp %d: at least 2 samples per pixel (for the standard error)", opts->spp);
     if (opts->max_order < 0) return veil_fail(err, VEIL_ERR_INVALID, "max_order %d: expected >= 0", opts->max_order);
     int sampling = opts->light_sampling == VEIL_PT_LIGHT_SAMPLING_DEFAULT ? VEIL_PT_LIGHT_SAMPLING_MIS

@@ -1,5 +1,6 @@
 #include "march.h"
 
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -134,9 +135,9 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
     memset(u, 0, sizeof *u);
     const veil_lit_medium* lm = &d->medium;
     set3(u->cam_pos, cam.pos, 0.0f);
-    set3(u->cam_fwd, cam.fwd, 0.0f);
-    set3(u->cam_right, cam.right, 0.0f);
-    set3(u->cam_up, cam.up, 0.0f);
+    set3(u->cam_fwd, cam.center, 0.0f);
+    set3(u->cam_right, cam.right, cam.clip[0]);
+    set3(u->cam_up, cam.up, isfinite(cam.clip[1]) ? cam.clip[1] : FLT_MAX);
     if (!d->no_background) set3(u->background, lm->scene->background, 0.0f);
     u->march[0] = lm->grid ? d->step_voxels * lm->grid->voxel : VEIL_FOG_MIN_STEP;
     u->limits[0] = d->max_distance > 0.0f ? d->max_distance : 3.0e38f;
@@ -303,6 +304,9 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
             if (report) { /* what is reported is done */
                 glFinish();
                 veil_progress("march, rows", y + band < h ? y + band : h, h);
+                if (veil_progress_cancelled() && y + band < h)
+                    r = veil_fail(err, VEIL_ERR_CANCELLED, "cancelled by the progress callback during the march "
+                                  "(%d of %d rows done)", y + band, h);
             } else {
                 glFlush();
             }

@@ -19,14 +19,31 @@ veil_result veil_camera_make_basis(const veil_camera* c, int width, int height, 
         return veil_fail(err, VEIL_ERR_INVALID, "camera: up is parallel to the view direction");
     glm_vec3_normalize(right);
     glm_vec3_cross(right, fwd, up);
-    float t = tanf(c->fov_y_deg * (float)(VEIL_PI / 360.0));
-    glm_vec3_scale(right, t * (float)width / (float)height, right);
-    glm_vec3_scale(up, t, up);
+    double tx, ty;
+    veil_camera_tan_half(c, width, height, &tx, &ty);
+    /* the shift in units of the fitted side's extent, 2 tan(fov / 2) at unit distance (Blender's) */
+    double extent = 2.0 * tan(c->fov_y_deg * (VEIL_PI / 360.0));
+    out->offset[0] = (float)(c->shift[0] * extent), out->offset[1] = (float)(c->shift[1] * extent);
+    for (int a = 0; a < 3; ++a)
+        out->center[a] = fwd[a] + out->offset[0] * right[a] + out->offset[1] * up[a]; /* right, up: unit here */
+    glm_vec3_scale(right, (float)tx, right);
+    glm_vec3_scale(up, (float)ty, up);
     glm_vec3_copy(pos, out->pos);
     glm_vec3_copy(fwd, out->fwd);
     glm_vec3_copy(right, out->right);
     glm_vec3_copy(up, out->up);
+    out->clip[0] = c->clip[0];
+    out->clip[1] = c->clip[1] > 0.0f ? c->clip[1] : INFINITY;
     return VEIL_OK;
+}
+
+void veil_camera_tan_half(const veil_camera* c, int width, int height, double* tx, double* ty)
+{
+    double t = tan(c->fov_y_deg * (VEIL_PI / 360.0)), aspect = (double)width / (double)height;
+    int fit = c->sensor_fit;
+    if (fit == VEIL_FIT_AUTO) fit = width >= height ? VEIL_FIT_HORIZONTAL : VEIL_FIT_VERTICAL;
+    *tx = fit == VEIL_FIT_HORIZONTAL ? t : t * aspect;
+    *ty = fit == VEIL_FIT_HORIZONTAL ? t / aspect : t;
 }
 
 void veil_camera_ray(const veil_camera_basis* b, int width, int height, int px, int py, float dir[3])
@@ -35,7 +52,7 @@ void veil_camera_ray(const veil_camera_basis* b, int width, int height, int px, 
     float sy = 1.0f - 2.0f * ((float)py + 0.5f) / (float)height;
     float n = 0.0f;
     for (int a = 0; a < 3; ++a) {
-        dir[a] = b->fwd[a] + sx * b->right[a] + sy * b->up[a];
+        dir[a] = b->center[a] + sx * b->right[a] + sy * b->up[a];
         n += dir[a] * dir[a];
     }
     n = sqrtf(n);
@@ -83,7 +100,9 @@ void veil_camera_exr_matrices(const veil_camera_basis* b, float world_to_camera[
      * Z = 1 (ndc z = 1/depth), W = z */
     p[0][0] = 0.5 / len[0];
     p[1][1] = -0.5 / len[1];
-    p[2][0] = p[2][1] = 0.5;
+    /* with a shift the image's centre is at (x, y) / z = offset: ndc_x = 1/2 + (x / z - off_x) / (2 tan_x) */
+    p[2][0] = 0.5 - 0.5 * b->offset[0] / len[0];
+    p[2][1] = 0.5 + 0.5 * b->offset[1] / len[1];
     p[2][3] = 1.0;
     p[3][2] = 1.0;
     for (int i = 0; i < 4; ++i)

@@ -1,9 +1,12 @@
 /* veil — the pinhole camera: position, look-at point, up vector and
- * vertical field of view. Pixel (px, py), py = 0 the top row, looks along
- * normalize(fwd + sx * right + sy * up) with sx = 2 (px + 0.5) / W - 1 and
- * sy = 1 - 2 (py + 0.5) / H, where right and up are scaled by
- * tan(fov_y / 2) (right also by the aspect W / H). render/shaders/march.comp
- * uses the same formula. Also the turntable's camera of frame f. */
+ * field of view along its sensor fit, with a lens shift and clip planes.
+ * Pixel (px, py), py = 0 the top row, looks along
+ * normalize(center + sx * right + sy * up) with sx = 2 (px + 0.5) / W - 1
+ * and sy = 1 - 2 (py + 0.5) / H, where right and up are scaled by
+ * tan(fov_x / 2) and tan(fov_y / 2) (one of them from the camera's fov, the
+ * other by the aspect W / H), and center = fwd + shift x (fitted extent)
+ * along right and up. render/shaders/march.comp uses the same formula.
+ * Also the turntable's camera of frame f. */
 #ifndef VEIL_CAMERA_H
 #define VEIL_CAMERA_H
 
@@ -12,7 +15,15 @@
 
 typedef struct veil_camera_basis {
     float pos[3], fwd[3], right[3], up[3];
+    float center[3];  /* the image centre's direction: fwd, moved by the shift (rays go through
+                         center + sx right + sy up) */
+    float offset[2];  /* the shift at unit distance along fwd, in right's and up's unit directions */
+    float clip[2];    /* near, far along fwd (m); far INFINITY when the camera has none */
 } veil_camera_basis;
+
+/* tan of half the field of view across the width (*tx) and the height
+ * (*ty) of a width x height image, from the camera's fov and sensor fit. */
+void veil_camera_tan_half(const veil_camera* c, int width, int height, double* tx, double* ty);
 
 veil_result veil_camera_make_basis(const veil_camera* c, int width, int height, veil_camera_basis* out,
                                    veil_error* err);

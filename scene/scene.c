@@ -2,11 +2,100 @@
 #include "scene.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/hash.h"
 #include "frame_pattern.h"
+
+/* At most this many values in a grid from memory (as VEIL_VDB_MAX_DENSE_VOXELS: 2^30 floats, 4 GiB). */
+#define VEIL_SCENE_GRID_MAX_VALUES ((size_t)1 << 30)
+
+int veil_affine_check(const double m[4][4], double* det)
+{
+    *det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    if (m[3][0] != 0.0 || m[3][1] != 0.0 || m[3][2] != 0.0 || m[3][3] != 1.0) return -1;
+    double scale = 0.0; /* the longest column: a determinant under 1e-12 of its cube is singular in double */
+    for (int c = 0; c < 3; ++c) scale = fmax(scale, sqrt(m[0][c] * m[0][c] + m[1][c] * m[1][c] + m[2][c] * m[2][c]));
+    return fabs(*det) > 1e-12 * scale * scale * scale ? 1 : 0;
+}
+
+const veil_scene_grid* veil_scene_grid_find(const veil_scene* s, const char* name)
+{
+    for (size_t i = 0; s && name && i < s->grid_count; ++i)
+        if (!strcmp(s->grids[i].name, name)) return &s->grids[i];
+    return NULL;
+}
+
+veil_result veil_scene_grid_set(veil_scene* s, const char* name, const float* data, const int dims[3], int z_fastest,
+                                const double index_to_world[4][4], veil_error* err)
+{
+    if (!name[0]) return veil_fail(err, VEIL_ERR_INVALID, "grid: the name is empty");
+    size_t n = 1;
+    for (int a = 0; a < 3; ++a) {
+        if (dims[a] < 1 || (size_t)dims[a] > VEIL_SCENE_GRID_MAX_VALUES)
+            return veil_fail(err, VEIL_ERR_INVALID, "grid '%.200s': dimension %d is %d (expected 1..2^30)", name, a,
+                             dims[a]);
+        n *= (size_t)dims[a];
+        if (n > VEIL_SCENE_GRID_MAX_VALUES)
+            return veil_fail(err, VEIL_ERR_LIMIT, "grid '%.200s': %dx%dx%d values, over the limit of 2^30", name,
+                             dims[0], dims[1], dims[2]);
+    }
+    const double(*m)[4] = index_to_world;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+            if (!isfinite(m[r][c]))
+                return veil_fail(err, VEIL_ERR_INVALID, "grid '%.200s': index_to_world[%d][%d] is not finite", name,
+                                 r, c);
+    double det;
+    int affine = veil_affine_check(m, &det);
+    if (affine < 0)
+        return veil_fail(err, VEIL_ERR_INVALID, "grid '%.200s': index_to_world's last row is %g %g %g %g, not 0 0 0 1 "
+                         "(an affine map)", name, m[3][0], m[3][1], m[3][2], m[3][3]);
+    if (affine == 0)
+        return veil_fail(err, VEIL_ERR_INVALID, "grid '%.200s': index_to_world is singular (determinant %g)", name, det);
+    /* a value that is not finite, refused here: OpenVDB's copyFromDense would take a NaN for the
+     * background (its comparison with 0 is false) and the grid would read 0 there, silently */
+    size_t bad = 0, first = 0;
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(data[i]) && bad++ == 0) first = i;
+    if (bad)
+        return veil_fail(err, VEIL_ERR_INVALID, "grid '%.200s': %zu value%s not finite (NaN or infinite), the first "
+                         "at offset %zu of %zu", name, bad, bad == 1 ? " is" : "s are", first, n);
+    float* copy = malloc(n * sizeof *copy);
+    char* nm = malloc(strlen(name) + 1);
+    veil_scene_grid* slot = (veil_scene_grid*)veil_scene_grid_find(s, name);
+    if (!slot && copy && nm) {
+        veil_scene_grid* g = realloc(s->grids, (s->grid_count + 1) * sizeof *g);
+        if (g) {
+            s->grids = g;
+            slot = &g[s->grid_count++];
+            memset(slot, 0, sizeof *slot);
+        }
+    }
+    if (!copy || !nm || !slot) {
+        free(copy);
+        free(nm);
+        return veil_fail(err, VEIL_ERR_OOM, "grid '%.200s': out of memory for %zu values", name, n);
+    }
+    memcpy(copy, data, n * sizeof *copy);
+    strcpy(nm, name);
+    free(slot->name);
+    free(slot->data);
+    slot->name = nm;
+    slot->data = copy;
+    memcpy(slot->dims, dims, sizeof slot->dims);
+    slot->z_fastest = z_fastest != 0;
+    memcpy(slot->index_to_world, index_to_world, sizeof slot->index_to_world);
+    uint64_t h = veil_hash_words(VEIL_FNV_OFFSET, copy, n * sizeof *copy);
+    h = veil_hash_bytes(h, slot->dims, sizeof slot->dims);
+    h = veil_hash_bytes(h, &slot->z_fastest, sizeof slot->z_fastest);
+    slot->hash = veil_hash_bytes(h, slot->index_to_world, sizeof slot->index_to_world);
+    return VEIL_OK;
+}
 
 void veil_scene_free(veil_scene* s)
 {
@@ -21,6 +110,11 @@ void veil_scene_free(veil_scene* s)
         free(s->medium.sources[i].vdb.temperature_grid);
     }
     free(s->medium.sources);
+    for (size_t i = 0; i < s->grid_count; ++i) {
+        free(s->grids[i].name);
+        free(s->grids[i].data);
+    }
+    free(s->grids);
     free(s->lights);
     free(s->path);
     free(s->base_dir);

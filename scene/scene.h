@@ -12,6 +12,7 @@
 #define VEIL_SCENE_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "../core/result.h"
 #include "../core/shared.glsl.h"
@@ -26,12 +27,25 @@
 #define VEIL_SCENE_MAX_RESOLUTION 2048 /* voxels per side; GL limit checked later */
 #define VEIL_SCENE_MAX_PARTICLES 10000000u
 
+/* Which side of the image the field of view spans (a DCC camera's sensor fit). */
+typedef enum veil_sensor_fit {
+    VEIL_FIT_VERTICAL = 0,   /* the height (the default: "fov_y_deg") */
+    VEIL_FIT_HORIZONTAL = 1, /* the width */
+    VEIL_FIT_AUTO = 2        /* the larger side (the width when they are equal), as Blender's AUTO */
+} veil_sensor_fit;
+
 typedef struct veil_camera {
     float position[3];
     float look_at[3];
     float up[3];      /* default (0,1,0) */
-    float fov_y_deg;  /* vertical field of view, (0,180) */
+    float fov_y_deg;  /* field of view along the sensor_fit side, (0,180): the vertical one by default,
+                         hence the name (the scene file's "fov_y_deg", or "fov_deg") */
     int width, height;
+    int sensor_fit;   /* veil_sensor_fit */
+    float shift[2];   /* the image window moved right (x) and up (y), in units of the fitted side's extent
+                         (Blender's shift_x, shift_y); 0: centred on the view axis */
+    float clip[2];    /* near and far distance along the view axis (m); the medium outside is not seen
+                         (the background still is); far 0: no far plane */
 } veil_camera;
 
 typedef enum veil_phase_type { VEIL_PHASE_ISOTROPIC = 0, VEIL_PHASE_HG = 1 } veil_phase_type;
@@ -45,10 +59,13 @@ typedef enum veil_source_type {
     VEIL_SOURCE_RBF = 0,
     VEIL_SOURCE_RBF_RANDOM = 1,
     VEIL_SOURCE_VDB = 2,
-    VEIL_SOURCE_EXPONENTIAL = 3
+    VEIL_SOURCE_EXPONENTIAL = 3,
+    VEIL_SOURCE_ARRAY = 4 /* a grid from memory (veil_scene_set_grid): a vdb source without a file */
 } veil_source_type;
 
-/* An OpenVDB float grid ({"type":"vdb", ...}). */
+/* An OpenVDB float grid ({"type":"vdb", ...}), or a grid from memory
+ * ({"type":"array", ...}: no file, no sequence, no level set; its grids are
+ * the scene's, veil_scene_grid, found by name). */
 typedef struct veil_vdb_source {
     char* file;          /* resolved against the scene's folder (owned); for a sequence, the current frame's */
     char* sequence;      /* the file's frame pattern when "file" holds one ("smoke.####.vdb"), resolved
@@ -72,6 +89,11 @@ typedef struct veil_vdb_source {
     char* temperature_grid; /* owned */
     float temperature_scale, temperature_offset;
     float temperature_intensity; /* < 0: sigma_a (the default) */
+    /* "transform": the source placed in the world, column vectors, affine and invertible: world =
+     * transform x (the grid's own index-to-world map), for the density, emission and temperature
+     * grids alike. has_transform 0: the grids' own maps */
+    int has_transform;
+    double transform[4][4];
 } veil_vdb_source;
 
 /* Analytic exponential (height) fog ({"type":"exponential", ...}):
@@ -94,7 +116,7 @@ typedef struct veil_source {
     char* particle_file; /* the particle file they were read from, resolved (owned); NULL: inline */
     /* VEIL_SOURCE_RBF_RANDOM */
     veil_rbf_random_desc random;
-    /* VEIL_SOURCE_VDB */
+    /* VEIL_SOURCE_VDB and VEIL_SOURCE_ARRAY */
     veil_vdb_source vdb;
     /* VEIL_SOURCE_EXPONENTIAL */
     veil_exp_fog fog;
@@ -220,6 +242,17 @@ const char* veil_quality_name(veil_quality q);
 /* 1 on success */
 int veil_quality_parse(const char* name, veil_quality* out);
 
+/* A grid given from memory (veil_scene_set_grid), read by the "array"
+ * sources that name it. */
+typedef struct veil_scene_grid {
+    char* name;                 /* owned */
+    float* data;                /* dims product floats (owned): x fastest, or z fastest when z_fastest */
+    int dims[3];
+    int z_fastest;
+    double index_to_world[4][4]; /* column vectors */
+    uint64_t hash;              /* of the values, dims, order and map: the stage caches' key */
+} veil_scene_grid;
+
 typedef struct veil_scene {
     char* path;     /* the file as given (owned) */
     char* base_dir; /* its folder, for relative paths (owned) */
@@ -230,9 +263,25 @@ typedef struct veil_scene {
     float background[3]; /* linear RGB radiance seen through the medium */
     veil_multiple multiple;
     veil_quality quality; /* "quality": UNSET when absent */
+    veil_scene_grid* grids; /* owned; grid_count of them */
+    size_t grid_count;
 } veil_scene;
 
 void veil_scene_free(veil_scene* s); /* accepts NULL and zeroed scenes */
+
+/* Copies a grid into s under `name`, replacing one of the same name (an
+ * "array" source reads it). Checks the dimensions (each >= 1, the product
+ * within VEIL_VDB_MAX_DENSE_VOXELS' 2^30) and that the map is affine with a
+ * finite, invertible 3x3 part; the values are checked when read. */
+veil_result veil_scene_grid_set(veil_scene* s, const char* name, const float* data, const int dims[3], int z_fastest,
+                                const double index_to_world[4][4], veil_error* err);
+/* An index-to-world or placement matrix m (column vectors, finite): 1 when
+ * it is affine (last row 0 0 0 1) and invertible, 0 when affine but
+ * singular (|det| <= 1e-12 x its longest column's cube: a voxel of no
+ * volume), -1 when not affine. *det: its 3x3 part's determinant. */
+int veil_affine_check(const double m[4][4], double* det);
+/* The grid named `name`, or NULL. */
+const veil_scene_grid* veil_scene_grid_find(const veil_scene* s, const char* name);
 
 /* Points every sequence source of s at its file for frame `frame`
  * (pattern frame + frame_offset). VEIL_ERR_IO naming the source, the frame

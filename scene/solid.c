@@ -21,7 +21,7 @@ static void normalize3(float v[3])
 /* The ray through image point (sx, sy) in [-1, 1] (x right, y up). */
 static void ray_at(const veil_camera_basis* b, float sx, float sy, float dir[3])
 {
-    for (int a = 0; a < 3; ++a) dir[a] = b->fwd[a] + sx * b->right[a] + sy * b->up[a];
+    for (int a = 0; a < 3; ++a) dir[a] = b->center[a] + sx * b->right[a] + sy * b->up[a];
     normalize3(dir);
 }
 

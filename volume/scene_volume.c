@@ -33,19 +33,50 @@ static void grow(float lo[3], float hi[3], int* any, const float a[3], const flo
     *any = 1;
 }
 
+/* Opens grid `name` of source i: a vdb source's from its file, an array
+ * source's from the scene's grids (veil_scene_set_grid); then places it
+ * by the source's transform. Errors name the source and the field. */
+static veil_result open_grid(const veil_scene* s, const veil_source* src, size_t i, const char* field,
+                             const char* name, int level_set_to_fog, veil_vdb** out, char* chosen, size_t chosen_len,
+                             veil_error* err)
+{
+    veil_error inner = {{0}};
+    veil_result r;
+    *out = NULL;
+    if (src->type == VEIL_SOURCE_ARRAY) {
+        const veil_scene_grid* g = veil_scene_grid_find(s, name);
+        if (!g)
+            return veil_fail(err, VEIL_ERR_INVALID, "medium.sources[%zu]%s: no grid '%.200s' was given (an \"array\" "
+                             "source reads a grid from memory: veil_scene_set_grid, or grids={'%.200s': array} in "
+                             "Python)", i, field, name, name);
+        char label[288];
+        snprintf(label, sizeof label, "<array '%.200s'>", name);
+        r = veil_vdb_from_dense(label, name, g->data, g->dims, g->z_fastest, g->index_to_world, out, &inner);
+        if (r == VEIL_OK && chosen) snprintf(chosen, chosen_len, "%s", name);
+    } else {
+        r = veil_vdb_open(src->vdb.file, name, level_set_to_fog, out, chosen, chosen_len, &inner);
+    }
+    if (r == VEIL_OK && src->vdb.has_transform) r = veil_vdb_place(*out, src->vdb.transform, &inner);
+    if (r != VEIL_OK) {
+        veil_vdb_close(*out);
+        *out = NULL;
+        return veil_fail(err, r, "medium.sources[%zu]%s: %.1900s", i, field, inner.msg);
+    }
+    return VEIL_OK;
+}
+
 /* Opens source i's emission (temperature: 1) grid, of the same file, and
  * grows [lo, hi] by its support. The source's density grid is the last
  * opened (vdbs[vdb_count - 1]). */
-static veil_result open_emission(veil_scene_volume* v, const veil_source* src, size_t i, int temperature, float lo[3],
-                                 float hi[3], int* any, veil_error* err)
+static veil_result open_emission(const veil_scene* s, veil_scene_volume* v, const veil_source* src, size_t i,
+                                 int temperature, float lo[3], float hi[3], int* any, veil_error* err)
 {
     veil_vdb* e = NULL;
     veil_error inner = {{0}};
     const char* name = temperature ? src->vdb.temperature_grid : src->vdb.emission_grid;
-    veil_result r = veil_vdb_open(src->vdb.file, name, 0, &e, NULL, 0, &inner);
-    if (r != VEIL_OK)
-        return veil_fail(err, r, "medium.sources[%zu].%s.grid: %.1900s", i, temperature ? "temperature" : "emission",
-                         inner.msg);
+    veil_result r = open_grid(s, src, i, temperature ? ".temperature.grid" : ".emission.grid", name, 0, &e, NULL, 0,
+                              err);
+    if (r != VEIL_OK) return r;
     veil_emission_source* es = &v->emission[v->emission_count++];
     memset(es, 0, sizeof *es);
     es->grid = e;
@@ -74,23 +105,23 @@ static veil_result open_emission(veil_scene_volume* v, const veil_source* src, s
 }
 
 /* Opens source i's grid and grows [lo, hi] by its support. */
-static veil_result open_vdb(veil_scene_volume* v, const veil_source* src, size_t i, float lo[3], float hi[3],
-                            int* any, veil_error* err)
+static veil_result open_vdb(const veil_scene* s, veil_scene_volume* v, const veil_source* src, size_t i, float lo[3],
+                            float hi[3], int* any, veil_error* err)
 {
     if (v->vdb_count == VEIL_MAX_VDB_SOURCES)
         return veil_fail(err, VEIL_ERR_LIMIT, "medium.sources[%zu]: at most %d vdb sources", i, VEIL_MAX_VDB_SOURCES);
     char chosen[256];
     veil_vdb* vdb = NULL;
     veil_error inner = {{0}};
-    if (veil_progress_wanted()) {
+    if (veil_progress_wanted() && src->vdb.file) {
         const char* base = strrchr(src->vdb.file, '/');
         char what[160];
         snprintf(what, sizeof what, "reading %.140s", base ? base + 1 : src->vdb.file);
         veil_progress(what, 0, 1);
     }
-    veil_result r = veil_vdb_open(src->vdb.file, src->vdb.grid, src->vdb.level_set_to_fog, &vdb, chosen,
-                                  sizeof chosen, &inner);
-    if (r != VEIL_OK) return veil_fail(err, r, "medium.sources[%zu]: %.1900s", i, inner.msg);
+    veil_result r = open_grid(s, src, i, src->type == VEIL_SOURCE_ARRAY ? ".grid" : "", src->vdb.grid,
+                              src->vdb.level_set_to_fog, &vdb, chosen, sizeof chosen, err);
+    if (r != VEIL_OK) return r;
     v->vdbs[v->vdb_count] = vdb;
     v->vdb_scale[v->vdb_count++] = src->vdb.density_scale;
     r = veil_vdb_check_values(vdb, VEIL_VALUES_DENSITY, src->vdb.density_scale, 0.0, &inner);
@@ -105,8 +136,8 @@ static veil_result open_vdb(veil_scene_volume* v, const veil_source* src, size_t
     }
     v->vdb_voxels += active;
     if (r != VEIL_OK) return r;
-    if (src->vdb.emission_grid) r = open_emission(v, src, i, 0, lo, hi, any, err);
-    if (r == VEIL_OK && src->vdb.temperature_grid) r = open_emission(v, src, i, 1, lo, hi, any, err);
+    if (src->vdb.emission_grid) r = open_emission(s, v, src, i, 0, lo, hi, any, err);
+    if (r == VEIL_OK && src->vdb.temperature_grid) r = open_emission(s, v, src, i, 1, lo, hi, any, err);
     return r;
 }
 
@@ -206,9 +237,20 @@ uint64_t veil_scene_volume_key(const veil_scene* s)
             k = veil_hash_bytes(k, d->bounds, sizeof d->bounds);
             k = veil_hash_bytes(k, d->radius, sizeof d->radius);
             k = veil_hash_bytes(k, d->amplitude, sizeof d->amplitude);
-        } else if (src->type == VEIL_SOURCE_VDB) {
+        } else if (src->type == VEIL_SOURCE_VDB || src->type == VEIL_SOURCE_ARRAY) {
             const char* grid = src->vdb.grid ? src->vdb.grid : "";
-            k = hash_file_identity(k, src->vdb.file);
+            if (src->type == VEIL_SOURCE_VDB) {
+                k = hash_file_identity(k, src->vdb.file);
+            } else { /* the grids' contents, by name (a grid not given keys as such; opening it reports it) */
+                const char* names[3] = {src->vdb.grid, src->vdb.emission_grid, src->vdb.temperature_grid};
+                for (int g = 0; g < 3; ++g) {
+                    const veil_scene_grid* sg = veil_scene_grid_find(s, names[g]);
+                    uint64_t h = sg ? sg->hash : 0;
+                    k = veil_hash_bytes(k, &h, sizeof h);
+                }
+            }
+            k = veil_hash_bytes(k, &src->vdb.has_transform, sizeof src->vdb.has_transform);
+            k = veil_hash_bytes(k, src->vdb.transform, sizeof src->vdb.transform);
             k = veil_hash_bytes(k, grid, strlen(grid) + 1);
             k = veil_hash_bytes(k, &src->vdb.density_scale, sizeof src->vdb.density_scale);
             k = veil_hash_bytes(k, &src->vdb.level_set_to_fog, sizeof src->vdb.level_set_to_fog);
@@ -439,7 +481,8 @@ veil_result veil_scene_volume_open(const veil_scene* s, veil_scene_volume* out, 
     float lo[3], hi[3], a[3], b[3];
     int any = 0;
     for (size_t i = 0; i < s->medium.source_count && r == VEIL_OK; ++i)
-        if (s->medium.sources[i].type == VEIL_SOURCE_VDB) r = open_vdb(&v, &s->medium.sources[i], i, lo, hi, &any, err);
+        if (s->medium.sources[i].type == VEIL_SOURCE_VDB || s->medium.sources[i].type == VEIL_SOURCE_ARRAY)
+            r = open_vdb(s, &v, &s->medium.sources[i], i, lo, hi, &any, err);
     if (r == VEIL_OK) {
         if (veil_rbf_bounds(v.particles, v.particle_count, a, b)) grow(lo, hi, &any, a, b);
         if (any) r = choose_grid(s, &v, lo, hi, err);

@@ -1,4 +1,5 @@
 #include "cache.h"
+#include "../core/progress.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -420,6 +421,8 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     const double units_e = (float)(phi_max > 0.0 ? ldexp(1.0, VEIL_CACHE_FIXED_BITS) / (3.0 * phi_max) : 1.0);
     glUseProgram(p->trace[2 * solid + sparse]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_CACHE_EMIT, buf[2]);
+    const int report = veil_progress_wanted();
+    long long sent = 0;
     for (int j = 0; j < n_src; ++j) {
         const veil_cache_block* o = &src[j].b;
         b.source[0] = o->source[0];
@@ -439,6 +442,16 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
             glNamedBufferSubData(p->ubo, 0, sizeof b, &b);
             glDispatchCompute(veil_groups((int)n, VEIL_CACHE_GROUP), 1, 1);
             glMemoryBarrier(GL_UNIFORM_BARRIER_BIT);
+            sent += n;
+            if (report) { /* what is reported is done; a cancel stops between dispatches */
+                glFinish();
+                veil_progress("light cache, photons", (double)sent, (double)rep->photons);
+                if (veil_progress_cancelled() && sent < rep->photons) {
+                    r = veil_fail(err, VEIL_ERR_CANCELLED, "cancelled by the progress callback during the light "
+                                  "cache (%lld of %lld photons traced)", sent, rep->photons);
+                    goto done;
+                }
+            }
         }
     }
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);

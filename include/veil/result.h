@@ -39,7 +39,8 @@ extern "C" {
     X(VEIL_ERR_OOM, 4, "out of memory")                                        \
     X(VEIL_ERR_LIMIT, 5, "a size exceeds a limit")                             \
     X(VEIL_ERR_GPU, 6, "GPU or driver failure")                                \
-    X(VEIL_ERR_SHADER, 7, "shader compile or link failed")
+    X(VEIL_ERR_SHADER, 7, "shader compile or link failed")                     \
+    X(VEIL_ERR_CANCELLED, 8, "cancelled by the caller")
 
 typedef int32_t veil_result;
 enum {

@@ -221,6 +221,10 @@ void main()
             t_end = max(t_end, fs.y);
         }
     }
+    // the camera's clip planes, distances along its view axis (up x right): the ray's share of them
+    float along = dot(dir, normalize(cross(u.cam_up.xyz, u.cam_right.xyz)));
+    t_begin = max(t_begin, u.cam_right.w / along);
+    t_end = min(t_end, u.cam_up.w / along);
     // a surface behind the medium (veil fog): the ray ends there, exactly
     if (u.flags.w != 0u) t_end = min(t_end, texelFetch(u_limit, p, 0).r);
     uint h = hash32(uint(p.x) + hash32(uint(p.y) + hash32(u.flags.z)));

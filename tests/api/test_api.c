@@ -230,6 +230,278 @@ static void render_and_read(veil_context* ctx, const veil_scene* scene)
  * Before each call made its own context current, the first context rendered
  * through the second's (VEIL_OK, wrong pixels), and after the second was
  * destroyed (eglTerminate of the display both share) NaN. */
+
+/* ---- grids from memory and the progress callback (veil 0.3) ------------- */
+
+#define GX 14
+#define GY 10
+#define GZ 7
+
+/* An asymmetric blob (no axis can be swapped without changing it) at index (i, j, k). */
+static float blob(int i, int j, int k)
+{
+    double x = (i - 5.0) / 4.0, y = (j - 4.5) / 3.0, z = (k - 3.0) / 2.5;
+    double r2 = x * x + y * y + z * z;
+    return r2 < 1.0 ? (float)(2.0 * (1.0 - r2) * (1.0 + 0.1 * i)) : 0.0f;
+}
+
+static veil_scene* array_scene(const char* source_extra)
+{
+    char json[1024];
+    snprintf(json, sizeof json,
+             "{\"camera\": {\"position\": [0.6, 0.5, 3], \"look_at\": [0.6, 0.45, 0.3], \"width\": 40, \"height\": 30},"
+             " \"medium\": {\"sigma_a\": [0.5, 0.5, 0.5], \"sigma_s\": [4, 4, 4],"
+             " \"sources\": [{\"type\": \"array\", \"grid\": \"density\"%s}]},"
+             " \"lights\": [{\"type\": \"directional\", \"direction\": [0.3, -1, -0.2], \"irradiance\": [2, 2, 2]}]}",
+             source_extra);
+    veil_scene* s = NULL;
+    veil_error err = {{0}};
+    CHECK(veil_scene_from_json(json, NULL, "array scene", &s, &err) == VEIL_OK && s, "array scene: %s", err.msg);
+    return s;
+}
+
+/* The blob in either order, with index_to_world m (NULL: all zero, the identity). */
+static veil_result set_blob(veil_scene* s, int order, const double* m, veil_error* err)
+{
+    static float x_fast[GX * GY * GZ], z_fast[GX * GY * GZ];
+    for (int k = 0; k < GZ; ++k)
+        for (int j = 0; j < GY; ++j)
+            for (int i = 0; i < GX; ++i) {
+                x_fast[i + GX * (j + GY * k)] = blob(i, j, k);
+                z_fast[k + GZ * (j + GY * i)] = blob(i, j, k);
+            }
+    veil_grid_desc g = VEIL_GRID_DESC_INIT;
+    g.data = order == VEIL_AXIS_ORDER_Z_FASTEST ? z_fast : x_fast;
+    g.dims[0] = GX, g.dims[1] = GY, g.dims[2] = GZ;
+    g.axis_order = order;
+    if (m) memcpy(g.index_to_world, m, sizeof g.index_to_world);
+    return veil_scene_set_grid(s, "density", &g, err);
+}
+
+static veil_image* render_small(veil_context* ctx, const veil_scene* s, const char* what)
+{
+    veil_render_desc d = VEIL_RENDER_DESC_INIT;
+    d.seed = 3;
+    veil_image* img = NULL;
+    veil_error err = {{0}};
+    veil_result r = veil_render(ctx, s, &d, &img, &err);
+    CHECK(r == VEIL_OK && img, "%s: %s: %s", what, veil_result_name(r), err.msg);
+    return img;
+}
+
+static double alpha_sum(const veil_image* img)
+{
+    int w = 0, h = 0;
+    veil_image_size(img, &w, &h);
+    const float* p = veil_image_rgba(img);
+    double a = 0.0;
+    for (int i = 0; p && i < w * h; ++i) a += p[4 * i + 3];
+    return a;
+}
+
+static void grids_from_memory(veil_context* ctx)
+{
+    /* 0.1 m voxels, the blob's corner at (0.1, 0.05, 0) */
+    const double m[16] = {0.1, 0, 0, 0.1, 0, 0.1, 0, 0.05, 0, 0, 0.1, 0, 0, 0, 0, 1};
+    veil_error err = {{0}};
+    veil_scene *a = array_scene(""), *b = array_scene("");
+    const char* placed_extra = ", \"transform\": [[0.1, 0, 0, 0.1], [0, 0.1, 0, 0.05], [0, 0, 0.1, 0], [0, 0, 0, 1]]";
+    veil_scene* c = array_scene(placed_extra);
+    if (!a || !b || !c) return;
+    CHECK(set_blob(a, VEIL_AXIS_ORDER_X_FASTEST, m, &err) == VEIL_OK, "x fastest: %s", err.msg);
+    CHECK(set_blob(b, VEIL_AXIS_ORDER_Z_FASTEST, m, &err) == VEIL_OK, "z fastest: %s", err.msg);
+    /* the grid's own map the identity, the source's transform the same m: world = m x I */
+    CHECK(set_blob(c, VEIL_AXIS_ORDER_X_FASTEST, NULL, &err) == VEIL_OK, "identity: %s", err.msg);
+    veil_image *ia = render_small(ctx, a, "x fastest"), *ib = render_small(ctx, b, "z fastest"),
+               *ic = render_small(ctx, c, "placed by the source's transform");
+    /* the same values at the same indices make the same tree: the same pixels, bit for bit */
+    CHECK(ia && ib && same_pixels(ia, ib), "x-fastest and z-fastest orders of one grid differ");
+    CHECK(ia && ic && same_pixels(ia, ic), "a grid's own map and the source's transform differ");
+    CHECK(ia && alpha_sum(ia) > 1.0, "the blob is not in the picture (alpha sum %g)", ia ? alpha_sum(ia) : 0.0);
+    /* the z-fastest buffer declared x-fastest is another (scrambled) field: it must not look the same */
+    veil_scene* d = array_scene("");
+    const double* none = NULL;
+    if (d) {
+        static float z_fast[GX * GY * GZ];
+        for (int k = 0; k < GZ; ++k)
+            for (int j = 0; j < GY; ++j)
+                for (int i = 0; i < GX; ++i) z_fast[k + GZ * (j + GY * i)] = blob(i, j, k);
+        veil_grid_desc g = VEIL_GRID_DESC_INIT;
+        g.data = z_fast;
+        g.dims[0] = GX, g.dims[1] = GY, g.dims[2] = GZ;
+        memcpy(g.index_to_world, m, sizeof m);
+        CHECK(veil_scene_set_grid(d, "density", &g, &err) == VEIL_OK, "scrambled: %s", err.msg);
+        veil_image* id = render_small(ctx, d, "scrambled");
+        CHECK(id && ia && !same_pixels(ia, id), "the axis order is ignored");
+        veil_image_destroy(id);
+        veil_scene_close(d);
+    }
+    (void)none;
+    /* replacing the grid changes the render (the stage caches key on the values) */
+    veil_grid_desc z = VEIL_GRID_DESC_INIT;
+    float zeros[8] = {0};
+    z.data = zeros, z.dims[0] = z.dims[1] = z.dims[2] = 2;
+    CHECK(veil_scene_set_grid(a, "density", &z, &err) == VEIL_OK, "empty grid: %s", err.msg);
+    veil_image* ie = render_small(ctx, a, "empty");
+    CHECK(ie && alpha_sum(ie) == 0.0, "an empty grid still shows a medium (alpha sum %g): stale cache?",
+          ie ? alpha_sum(ie) : -1.0);
+    veil_image_destroy(ie);
+
+    /* bad grids: refused by veil_scene_set_grid, or by veil_render naming the source */
+    veil_grid_desc g = VEIL_GRID_DESC_INIT;
+    g.data = zeros, g.dims[0] = 2, g.dims[1] = 0, g.dims[2] = 2;
+    CHECK(veil_scene_set_grid(a, "density", &g, &err) == VEIL_ERR_INVALID && strstr(err.msg, "dimension 1"),
+          "dims 0: %s", err.msg);
+    g.dims[1] = 2, g.axis_order = 2;
+    CHECK(veil_scene_set_grid(a, "density", &g, &err) == VEIL_ERR_INVALID && strstr(err.msg, "axis_order"),
+          "axis order 2: %s", err.msg);
+    g.axis_order = 0;
+    g.index_to_world[0] = 1, g.index_to_world[5] = 1, g.index_to_world[15] = 1; /* z column zero: singular */
+    CHECK(veil_scene_set_grid(a, "density", &g, &err) == VEIL_ERR_INVALID && strstr(err.msg, "singular"),
+          "singular: %s", err.msg);
+    g.index_to_world[10] = 1, g.index_to_world[12] = 0.5; /* last row 0.5 0 0 1 */
+    CHECK(veil_scene_set_grid(a, "density", &g, &err) == VEIL_ERR_INVALID && strstr(err.msg, "last row"),
+          "projective: %s", err.msg);
+    g.index_to_world[12] = 0;
+    g.data = NULL;
+    CHECK(veil_scene_set_grid(a, "density", &g, &err) == VEIL_ERR_INVALID && strstr(err.msg, "data"), "NULL data");
+    float nan_grid[8] = {0, 0, 0, NAN, 0, 0, 0, 0};
+    g.data = nan_grid;
+    CHECK(veil_scene_set_grid(a, "density", &g, &err) == VEIL_ERR_INVALID && strstr(err.msg, "not finite") &&
+              strstr(err.msg, "offset 3 of 8"),
+          "NaN: %s", err.msg);
+    veil_image* img = NULL;
+    veil_render_desc rd = VEIL_RENDER_DESC_INIT;
+    veil_result r;
+    veil_scene* none_given = array_scene("");
+    r = none_given ? veil_render(ctx, none_given, &rd, &img, &err) : VEIL_ERR_INVALID;
+    CHECK(r == VEIL_ERR_INVALID && !img && strstr(err.msg, "medium.sources[0].grid") &&
+              strstr(err.msg, "no grid 'density'"),
+          "no grid given: %s: %s", veil_result_name(r), err.msg);
+    veil_scene_close(none_given);
+    veil_image_destroy(ia);
+    veil_image_destroy(ib);
+    veil_image_destroy(ic);
+    veil_scene_close(a);
+    veil_scene_close(b);
+    veil_scene_close(c);
+}
+
+/* The clip planes and the shift in the march (the rays' geometry is
+ * tests/frame/test_frames.c's): a medium wholly beyond the far plane or
+ * before the near one is not seen (alpha exactly 0: the march meets no
+ * medium), planes around the whole medium change no pixel, and a shift
+ * that moves the frame off the medium leaves only the background. The
+ * medium: the blob at 0.1 m voxels, within 2.3..3.1 m of the camera along
+ * its view axis. */
+static void lens_in_the_march(veil_context* ctx)
+{
+    const double m[16] = {0.1, 0, 0, 0.1, 0, 0.1, 0, 0.05, 0, 0, 0.1, 0, 0, 0, 0, 1};
+    const char* extras[] = {"", ", \"clip\": [0.5, 2.0]", ", \"clip\": [4.0, 100]", ", \"clip\": [1.0, 50]",
+                            ", \"shift\": [1.5, 0]", ", \"shift\": [0.2, 0.1], \"sensor_fit\": \"auto\", \"fov_deg\": 45"};
+    veil_image* img[6] = {0};
+    for (int i = 0; i < 6; ++i) {
+        char json[1024];
+        snprintf(json, sizeof json,
+                 "{\"camera\": {\"position\": [0.6, 0.5, 3], \"look_at\": [0.6, 0.45, 0.3], \"width\": 40, "
+                 "\"height\": 30%s}, \"medium\": {\"sigma_a\": [0.5, 0.5, 0.5], \"sigma_s\": [4, 4, 4],"
+                 " \"sources\": [{\"type\": \"array\", \"grid\": \"density\"}]},"
+                 " \"lights\": [{\"type\": \"directional\", \"direction\": [0.3, -1, -0.2], \"irradiance\": [2, 2, 2]}]}",
+                 extras[i]);
+        veil_scene* s = NULL;
+        veil_error err = {{0}};
+        CHECK(veil_scene_from_json(json, NULL, "lens", &s, &err) == VEIL_OK && s, "lens %d: %s", i, err.msg);
+        if (!s) continue;
+        CHECK(set_blob(s, VEIL_AXIS_ORDER_X_FASTEST, m, &err) == VEIL_OK, "%s", err.msg);
+        img[i] = render_small(ctx, s, extras[i]);
+        veil_scene_close(s);
+    }
+    CHECK(img[0] && alpha_sum(img[0]) > 1.0, "no medium in view");
+    CHECK(img[1] && alpha_sum(img[1]) == 0.0, "the medium beyond the far plane is seen (alpha sum %g)",
+          img[1] ? alpha_sum(img[1]) : -1.0);
+    CHECK(img[2] && alpha_sum(img[2]) == 0.0, "the medium before the near plane is seen (alpha sum %g)",
+          img[2] ? alpha_sum(img[2]) : -1.0);
+    CHECK(img[0] && img[3] && same_pixels(img[0], img[3]), "planes around the whole medium changed the image");
+    CHECK(img[4] && alpha_sum(img[4]) == 0.0, "a frame shifted off the medium still sees it (alpha sum %g)",
+          img[4] ? alpha_sum(img[4]) : -1.0);
+    CHECK(img[5] && alpha_sum(img[5]) > 1.0 && !same_pixels(img[0], img[5]), "a small shift lost the medium or did nothing");
+    for (int i = 0; i < 6; ++i) veil_image_destroy(img[i]);
+}
+
+typedef struct progress_log {
+    int calls, bad, stop_at; /* stop_at: cancel at the first report of stage index stop_at (-1: never) */
+    int stage;               /* the index of the stage last seen */
+    double done;             /* its share last reported */
+    int ended[5];            /* a stage reported done = 1 */
+} progress_log;
+
+static const char* const STAGES[5] = {"inject", "propagate", "volumetric", "render", "spread"};
+
+static int on_progress(void* user, const char* stage, double done)
+{
+    progress_log* p = user;
+    int s = -1;
+    for (int i = 0; i < 5; ++i)
+        if (stage && !strcmp(stage, STAGES[i])) s = i;
+    ++p->calls;
+    /* a known stage, the stages in order, the share within 0..1 and never going back within a stage */
+    if (s < 0 || s < p->stage || !(done >= 0.0 && done <= 1.0) || (s == p->stage && done < p->done)) ++p->bad;
+    p->stage = s, p->done = done;
+    if (s >= 0 && done == 1.0) p->ended[s] = 1;
+    return s >= 0 && s == p->stop_at;
+}
+
+static void progress_and_cancel(veil_context* ctx, const veil_scene* scene)
+{
+    veil_error err = {{0}};
+    veil_image* img = NULL;
+    progress_log log = {.stop_at = -1, .stage = -1};
+    veil_render_desc d = VEIL_RENDER_DESC_INIT;
+    d.width = 48, d.height = 36, d.seed = 5, d.progress = on_progress, d.progress_user = &log;
+    CHECK(veil_render(ctx, scene, &d, &img, &err) == VEIL_OK && img, "render with progress: %s", err.msg);
+    CHECK(log.calls >= 5 && log.bad == 0, "progress: %d calls, %d out of order or range", log.calls, log.bad);
+    CHECK(log.ended[0] && log.ended[3] && log.ended[4], "not every stage reported its end");
+    veil_image_destroy(img);
+    img = NULL;
+    /* cancel when the march begins: no image, its own code, and the context still renders */
+    d.seed = 6; /* a new view key for the per-view stages */
+    progress_log stop = {.stop_at = 3, .stage = -1};
+    d.progress_user = &stop;
+    veil_result r = veil_render(ctx, scene, &d, &img, &err);
+    CHECK(r == VEIL_ERR_CANCELLED && img == NULL && strstr(err.msg, "cancelled"), "cancel: %s: %s",
+          veil_result_name(r), err.msg);
+    CHECK(stop.stage == 3, "the callback was called after it cancelled (last stage %d)", stop.stage);
+    CHECK(strcmp(veil_result_name(VEIL_ERR_CANCELLED), "VEIL_ERR_CANCELLED") == 0, "the code's name");
+    d.progress = NULL;
+    CHECK(veil_render(ctx, scene, &d, &img, &err) == VEIL_OK && img, "after a cancel: %s", err.msg);
+    if (img) { /* the stages before the cancel were kept */
+        const char* status = NULL;
+        veil_image_stage(img, 0, NULL, &status, NULL, NULL);
+        CHECK(status && strcmp(status, "cached") == 0, "inject after a cancelled render: %s", status ? status : "?");
+    }
+    veil_image_destroy(img);
+    /* a scene not seen before: a cancel asked for as the light cache begins stops it between its
+     * dispatches of photons (2^18 each: 10^6 photons make 4), not only at the next stage */
+    veil_scene* fresh = NULL;
+    const char* fresh_json =
+        "{\"camera\": {\"position\": [0.6, 0.5, 3], \"look_at\": [0.6, 0.45, 0.3], \"width\": 40, \"height\": 30},"
+        " \"medium\": {\"sigma_s\": [4, 4, 4], \"sources\": [{\"type\": \"array\", \"grid\": \"density\"}]},"
+        " \"multiple_scattering\": {\"volumetric_method\": \"cache\", \"cache_photons\": 1000000},"
+        " \"lights\": [{\"type\": \"point\", \"position\": [0.6, 2, 0.3], \"intensity\": [2, 2, 2]}]}";
+    CHECK(veil_scene_from_json(fresh_json, NULL, "fresh", &fresh, &err) == VEIL_OK, "fresh: %s", err.msg);
+    const double m[16] = {0.1, 0, 0, 0.1, 0, 0.1, 0, 0.05, 0, 0, 0.1, 0, 0, 0, 0, 1};
+    if (fresh && set_blob(fresh, VEIL_AXIS_ORDER_X_FASTEST, m, &err) == VEIL_OK) {
+        progress_log mid = {.stop_at = 2, .stage = -1};
+        veil_render_desc dc = VEIL_RENDER_DESC_INIT;
+        dc.progress = on_progress, dc.progress_user = &mid;
+        img = NULL;
+        r = veil_render(ctx, fresh, &dc, &img, &err);
+        CHECK(r == VEIL_ERR_CANCELLED && img == NULL && strstr(err.msg, "during the light cache"),
+              "cancel in the light cache: %s: %s", veil_result_name(r), err.msg);
+    }
+    veil_scene_close(fresh);
+}
+
 static void two_contexts(veil_context* ctx, const veil_scene* scene)
 {
     veil_error err = {{0}};
@@ -301,6 +573,9 @@ int main(int argc, char** argv)
         bad_descriptions(ctx, scene);
         render_and_read(ctx, scene);
         two_contexts(ctx, scene);
+        grids_from_memory(ctx);
+        lens_in_the_march(ctx);
+        progress_and_cancel(ctx, scene);
         other_thread(ctx, scene);
         CHECK(test_dir_end(), "temporary folder left clean");
     }

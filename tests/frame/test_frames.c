@@ -131,6 +131,60 @@ static void test_seeds(void)
     CHECK(veil_frame_seed(1, 5) != veil_frame_seed(2, 5), "the base seed matters");
 }
 
+/* The lens: the sensor fit and the shift (issue 25) against Blender's
+ * definition of the view plane, written in pixels as Blender writes it
+ * (BKE_camera_params_compute_viewplane): viewfac = W for a horizontal fit
+ * (AUTO: the larger side), H for a vertical one; at unit distance a pixel
+ * is 2 tan(fov / 2) / viewfac wide, and the plane spans
+ * [-W/2 + shift_x viewfac, W/2 + shift_x viewfac] pixels across (likewise
+ * in y). Pixel centres' rays must meet it there, and the EXR header's
+ * worldToNDC must map them to their pixel centres. */
+static void test_lens(void)
+{
+    const struct { int fit; int w, h; float shift[2]; } cases[] = {
+        {VEIL_FIT_VERTICAL, 64, 48, {0, 0}},     {VEIL_FIT_HORIZONTAL, 64, 48, {0, 0}},
+        {VEIL_FIT_AUTO, 64, 48, {0.1f, -0.2f}},  {VEIL_FIT_AUTO, 40, 60, {-0.3f, 0.05f}},
+        {VEIL_FIT_HORIZONTAL, 40, 60, {0.25f, 0.25f}}, {VEIL_FIT_VERTICAL, 64, 48, {0.5f, 0}},
+    };
+    for (size_t n = 0; n < sizeof cases / sizeof cases[0]; ++n) {
+        veil_camera c = {.position = {1, 2, 6}, .look_at = {1, 1, 0}, .up = {0, 1, 0}, .fov_y_deg = 50,
+                         .sensor_fit = cases[n].fit, .shift = {cases[n].shift[0], cases[n].shift[1]}};
+        const int w = cases[n].w, h = cases[n].h;
+        veil_camera_basis b;
+        veil_error err = {0};
+        CHECK(veil_camera_make_basis(&c, w, h, &b, &err) == VEIL_OK, "%s", err.msg);
+        int hor = c.sensor_fit == VEIL_FIT_HORIZONTAL || (c.sensor_fit == VEIL_FIT_AUTO && w >= h);
+        double viewfac = hor ? w : h, pix = 2.0 * tan(50.0 * VEIL_PI / 360.0) / viewfac;
+        /* the camera's frame: unit right, up, forward */
+        double R[3], U[3], F[3], nr = 0, nu = 0, nf = 0;
+        for (int a = 0; a < 3; ++a) R[a] = b.right[a], U[a] = b.up[a], F[a] = b.fwd[a];
+        for (int a = 0; a < 3; ++a) nr += R[a] * R[a], nu += U[a] * U[a], nf += F[a] * F[a];
+        for (int a = 0; a < 3; ++a) R[a] /= sqrt(nr), U[a] /= sqrt(nu), F[a] /= sqrt(nf);
+        veil_exr_meta m = {0};
+        veil_camera_exr_matrices(&b, m.world_to_camera, m.world_to_ndc);
+        const int px[3][2] = {{0, 0}, {w - 1, h - 1}, {w / 3, h / 2}};
+        for (int k = 0; k < 3; ++k) {
+            float dir[3];
+            veil_camera_ray(&b, w, h, px[k][0], px[k][1], dir);
+            double z = dir[0] * F[0] + dir[1] * F[1] + dir[2] * F[2];
+            double x = (dir[0] * R[0] + dir[1] * R[1] + dir[2] * R[2]) / z, y = (dir[0] * U[0] + dir[1] * U[1] + dir[2] * U[2]) / z;
+            /* Blender's plane, pixel centres (y up from the bottom: row py is h - 1 - py from it) */
+            double want_x = (-0.5 * w + c.shift[0] * viewfac + px[k][0] + 0.5) * pix;
+            double want_y = (-0.5 * h + c.shift[1] * viewfac + (h - 1 - px[k][1]) + 0.5) * pix;
+            /* float basis: a few ulps of values below ~2 */
+            CHECK(fabs(x - want_x) < 1e-5 && fabs(y - want_y) < 1e-5, "case %zu pixel (%d, %d): the ray meets the "
+                  "plane at (%g, %g), Blender's at (%g, %g)", n, px[k][0], px[k][1], x, y, want_x, want_y);
+            double p4[4] = {b.pos[0] + 3.0 * dir[0], b.pos[1] + 3.0 * dir[1], b.pos[2] + 3.0 * dir[2], 1.0}, q[4] = {0};
+            for (int j = 0; j < 4; ++j)
+                for (int i = 0; i < 4; ++i) q[j] += p4[i] * m.world_to_ndc[4 * i + j];
+            double nx = (px[k][0] + 0.5) / w, ny = (px[k][1] + 0.5) / h;
+            CHECK(fabs(q[0] / q[3] - nx) < 1e-5 && fabs(q[1] / q[3] - ny) < 1e-5,
+                  "case %zu pixel (%d, %d) meets NDC (%g, %g), want (%g, %g)", n, px[k][0], px[k][1], q[0] / q[3],
+                  q[1] / q[3], nx, ny);
+        }
+    }
+}
+
 static void test_header(void)
 {
     veil_camera c = {.position = {1, 2, 6}, .look_at = {1, 1, 0}, .up = {0, 1, 0}, .fov_y_deg = 40};
@@ -195,6 +249,7 @@ static void test_header(void)
 int main(void)
 {
     test_header();
+    test_lens();
     test_ranges();
     test_patterns();
     test_orbit();

@@ -342,7 +342,37 @@ static const bad_case BAD[] = {
     {"{'camera':{'position':'here','look_at':[0,0,0]}," MED "}", VEIL_ERR_INVALID, "camera.position",
      "expected an array of 3 numbers, each in [-1e15, 1e15] (m: scene/limits.h), got a string (\"here\")"},
     {"{'camera':{'position':[0,0,1],'look_at':[0,0,0],'fov':40}," MED "}", VEIL_ERR_INVALID, "camera.fov",
-     "unknown key (expected one of: position, look_at, up, fov_y_deg, width, height)"},
+     "unknown key (expected one of: position, look_at, up, fov_y_deg, fov_deg, sensor_fit, shift, clip, width, "
+     "height)"},
+    /* the sensor fit, the shift and the clip planes (issue 25) */
+    {"{'camera':{'position':[0,0,1],'look_at':[0,0,0],'sensor_fit':'diagonal'}," MED "}", VEIL_ERR_INVALID,
+     "camera.sensor_fit", "expected one of \"vertical\", \"horizontal\", \"auto\", got a string (\"diagonal\")"},
+    {"{'camera':{'position':[0,0,1],'look_at':[0,0,0],'fov_y_deg':30,'fov_deg':30}," MED "}", VEIL_ERR_INVALID,
+     "camera.fov_deg", "give either \"fov_y_deg\" (vertical) or \"fov_deg\" (along sensor_fit), not both"},
+    {"{'camera':{'position':[0,0,1],'look_at':[0,0,0],'fov_y_deg':30,'sensor_fit':'auto'}," MED "}", VEIL_ERR_INVALID,
+     "camera.fov_y_deg", "with sensor_fit \"auto\" give \"fov_deg\" instead"},
+    {"{'camera':{'position':[0,0,1],'look_at':[0,0,0],'fov_deg':180}," MED "}", VEIL_ERR_INVALID,
+     "camera.fov_deg", "expected a number of degrees in (0, 180)"},
+    {"{'camera':{'position':[0,0,1],'look_at':[0,0,0],'shift':[0.1,101]}," MED "}", VEIL_ERR_INVALID,
+     "camera.shift[1]", "expected a number in [-100, 100]"},
+    {"{'camera':{'position':[0,0,1],'look_at':[0,0,0],'clip':[2,1]}," MED "}", VEIL_ERR_INVALID,
+     "camera.clip", "expected [near, far] with 0 <= near < far (m along the view axis), got [2, 1]"},
+    {"{'camera':{'position':[0,0,1],'look_at':[0,0,0],'clip':[-1,1]}," MED "}", VEIL_ERR_INVALID,
+     "camera.clip", "got [-1, 1]"},
+    /* a source's transform and the array source (issue 25) */
+    {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'array','grid':'d','transform':[[1,0,0,0],[0,1,0,0],[0,0,1,0]]}]}}",
+     VEIL_ERR_INVALID, "medium.sources[0].transform", "expected an array of 4 rows of 4 numbers"},
+    {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'array','grid':'d','transform':[[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,1,1]]}]}}",
+     VEIL_ERR_INVALID, "medium.sources[0].transform[3]", "expected [0, 0, 0, 1] (veil takes affine maps), got [0, 0, 1, 1]"},
+    {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'array','grid':'d','transform':[[1,0,0,0],[0,1,0,0],[2,0,0,0],[0,0,0,1]]}]}}",
+     VEIL_ERR_INVALID, "medium.sources[0].transform", "the matrix is singular (determinant 0)"},
+    {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'array','grid':'d','transform':[[1,0,0,0],[0,1,0,0],[0,0,1,'x'],[0,0,0,1]]}]}}",
+     VEIL_ERR_INVALID, "medium.sources[0].transform[2][3]", "got a string"},
+    {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'array'}]}}", VEIL_ERR_INVALID, "medium.sources[0].grid",
+     "missing required field (a string)"},
+    {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'array','grid':'d','file':'x.vdb'}]}}", VEIL_ERR_INVALID,
+     "medium.sources[0].file",
+     "unknown key (expected one of: type, grid, density_scale, emission, temperature, transform)"},
     {"{'camera':{'position':[0,0,1],'position':[0,0,2],'look_at':[0,0,0]}," MED "}", VEIL_ERR_INVALID,
      "camera.position", "duplicate key"},
     {"{'camera':{'position':[0,0,1e999],'look_at':[0,0,0]}," MED "}", VEIL_ERR_INVALID,
@@ -381,7 +411,7 @@ static const bad_case BAD[] = {
     {"{" CAM ",'medium':{'sigma_s':[1,1,1]}}", VEIL_ERR_INVALID, "medium.sources",
      "missing required field (an array)"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[" SRC_OK ",{'particles':[]}]}}", VEIL_ERR_INVALID,
-     "medium.sources[1].type", "missing required field (one of \"rbf\", \"rbf_random\", \"vdb\", \"exponential\")"},
+     "medium.sources[1].type", "missing required field (one of \"rbf\", \"rbf_random\", \"vdb\", \"exponential\", \"array\")"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[" SRC_OK ",7]}}", VEIL_ERR_INVALID,
      "medium.sources[1]", "expected an object, got 7"},
     {"{" CAM ",'medium':{'sigma_s':[1,1,1],'sources':[{'type':'rbf','particles':["
@@ -533,7 +563,7 @@ static void test_exact_messages(void)
                         "(a number of degrees in (0, 180])") == 0, "%s", e.msg);
     parse("scene.json", "{'camera':{'position':[0,0,1],'look_at':[0,0,0],'fov':40}," MED "}", &s, &e);
     CHECK(strcmp(e.msg, "scene.json: camera.fov: unknown key (expected one of: position, look_at, up, "
-                        "fov_y_deg, width, height)") == 0, "%s", e.msg);
+                        "fov_y_deg, fov_deg, sensor_fit, shift, clip, width, height)") == 0, "%s", e.msg);
     parse("demo.json", "{'camera':{'look_at':[0,0,0]}," MED "}", &s, &e);
     CHECK(strcmp(e.msg, "demo.json: camera.position: missing required field (an array of 3 numbers, each in [-1e15, 1e15] (m: scene/limits.h))") == 0,
           "%s", e.msg);
