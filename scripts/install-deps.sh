@@ -12,6 +12,8 @@ packages=(
   g++ libopenvdb-dev libboost-dev libtbb-dev                     # the OpenVDB reader (io/vdb.cpp)
   libnanovdb-dev                                                 # .nvdb files (headers only, io/vdb.cpp)
   time                                                           # /usr/bin/time: tests bound a refusal's memory
+  python3 python3-numpy python3-pytest python3-openvdb           # the Python module and its tests (docs/python.md)
+  python3-setuptools python3-wheel python3-pip python3-venv      # pip install of python/ into a venv (tests/python)
 )
 
 missing=()

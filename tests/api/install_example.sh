@@ -4,7 +4,8 @@
 # CMake package (find_package(veil)) and through pkg-config; the installed
 # tree holds the tool, libveil.so, the two public headers, the package
 # files and the licence, and nothing else under include/; both builds render the demo scene
-# to the same bytes (same scene, same seed).
+# to the same bytes (same scene, same seed); the Python module imports from the installed
+# tree and reports the installed library's version.
 # Exit 77 (skipped) when no GL context can be made, except under CI=true.
 #   install_example.sh BUILD_DIR SOURCE_DIR
 # Environment: CMAKE, CC (the build's), VEIL_EXAMPLE_CFLAGS (sanitizers).
@@ -29,6 +30,23 @@ done
 [ -s "$prefix/share/doc/veil/LICENSE" ] || fail "the installed tree has no share/doc/veil/LICENSE"
 extra=$(cd "$prefix/include" && find . -mindepth 1 ! -path ./veil.h ! -path ./veil ! -path ./veil/result.h)
 [ -z "$extra" ] || fail "include/ holds more than the public headers: $extra"
+
+# (e) the Python module (docs/python.md): installed beside the library, it imports from the
+# installed tree alone (no VEIL_LIBRARY), loads the installed libveil.so and reports its version.
+# Not under sanitizers: an ASan libveil.so cannot be loaded into an uninstrumented python3.
+pkg=$(cd "$prefix" && find . -path '*/veil/_libpath.py' | head -n 1)
+[ -n "$pkg" ] || fail "the installed tree has no Python package (veil/_libpath.py)"
+pydir=$prefix/$(dirname "$(dirname "$pkg")")
+if [[ "$cflags" != *sanitize* ]]; then
+  py=$(cd "$tmp" && env -u VEIL_LIBRARY PYTHONPATH="$pydir" /usr/bin/python3 -c \
+       'import veil; print(veil.__version__); print(veil.library_path())' 2>&1) || fail "import veil from $pydir: $py"
+  pc_version=$(sed -n 's/^Version: *//p' "$prefix/lib/pkgconfig/veil.pc")
+  [ "$(sed -n 1p <<< "$py")" = "$pc_version" ] || fail "the installed module reports veil $(sed -n 1p <<< "$py"), veil.pc $pc_version"
+  case "$(sed -n 2p <<< "$py")" in
+    "$prefix"/*) ;;
+    *) fail "the installed module loaded $(sed -n 2p <<< "$py"), not the installed library" ;;
+  esac
+fi
 
 # (a) through the CMake package
 "$cmake" -S "$src/examples" -B "$tmp/ex-cmake" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release \
