@@ -5,6 +5,8 @@
 #   make data   generate the VDBs that data/scenes/vdb_smoke.json and pyro.json render
 #   make accuracy  time against error of the GPU path vs the CPU reference
 #                  (bench/accuracy --quick, under 2 minutes; FULL=1: the full sweep)
+#   make test-blender  the Blender add-on's tests (tests/blender/: installs blender, python3-numpy,
+#               python3-openvdb and python3-openimageio; headless, about half a minute)
 #   make test-farm  a turntable on a one-node Slurm cluster started on this machine
 #               (installs slurm-wlm, munge and ffmpeg; tests/cli/farm_test.sh; run as root)
 #   make peers  veil against OpenVDB's vdb_render, time against error on three VDBs
@@ -23,7 +25,7 @@
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
-.PHONY: all deps build demo test data clean accuracy test-sanitize fuzz peers test-farm bench-regress
+.PHONY: all deps build demo test data clean accuracy test-sanitize fuzz peers test-farm test-blender bench-regress
 FUZZ_SECONDS ?= 60
 
 all: build
@@ -47,6 +49,12 @@ test:
 	@$(MAKE) --no-print-directory deps
 	@$(MAKE) --no-print-directory build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE farm
+
+test-blender:
+	@$(MAKE) --no-print-directory deps
+	@bash scripts/install-bench-deps.sh blender python3-numpy python3-openvdb python3-openimageio
+	@$(MAKE) --no-print-directory build
+	@cd $(BUILD) && ctest --output-on-failure -L blender
 
 test-farm:
 	@$(MAKE) --no-print-directory deps
