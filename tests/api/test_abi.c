@@ -9,7 +9,9 @@
  *    veil_context_desc whose size is larger than the library's or the
  *    size of no layout, with VEIL_ERR_INVALID, a message naming both
  *    sizes, and *out NULL, before any GL context is made;
- *  - with "render SCENE": a render desc of size 0 (an old zeroed
+ *  - with "render SCENE": veil 0.2's render desc layout with a junk tail
+ *    renders as the new one (the progress callback is not read from it);
+ *    a render desc of size 0 (an old zeroed
  *    description), one from VEIL_RENDER_DESC_INIT and one followed by
  *    junk bytes agree bit for bit; too large or unknown sizes are refused the same
  *    way; a context from VEIL_CONTEXT_DESC_INIT renders. Exit 77 (skipped)
@@ -139,6 +141,28 @@ static int render_desc_sizes(const char* scene_path)
     veil_image_size(a, &w, &h);
     CHECK(w == 32 && h == 24, "size 0 desc read: %dx%d", w, h);
     CHECK(same_pixels(a, b) && same_pixels(a, c), "size 0, VEIL_RENDER_DESC_INIT and padded differ");
+
+    /* A program built against veil 0.2's header passes 0.2's layout (no progress callback) with its
+     * own size: the library reads those fields and no further (a junk tail read as the callback
+     * would be called and crash), the same image. */
+    typedef struct {
+        size_t size;
+        int width, height;
+        float step_voxels;
+        uint32_t seed;
+        long frame, frames;
+    } render_desc_0_2;
+    struct {
+        render_desc_0_2 desc;
+        unsigned char tail[64];
+    } v02;
+    memset(&v02, 0x5A, sizeof v02);
+    v02.desc = (render_desc_0_2){sizeof(render_desc_0_2), 32, 24, 0.0f, 11u, 0L, 0L};
+    veil_image* d = NULL;
+    CHECK(veil_render(ctx, scene, (const veil_render_desc*)(const void*)&v02.desc, &d, &err) == VEIL_OK,
+          "veil 0.2's layout (size %zu): %s", sizeof(render_desc_0_2), err.msg);
+    CHECK(d && same_pixels(a, d), "veil 0.2's layout renders another image");
+    veil_image_destroy(d);
 
     const size_t own = sizeof(veil_render_desc);
     const size_t bad[] = {own + sizeof(long), own + 64, 3, sizeof(size_t), own - sizeof(long)};
