@@ -1,6 +1,6 @@
 /* veil reference SCENE.json -o REF.exr --spp N [--max-order K] [--width W]
  *                [--height H] [--seed N] [--threads T]
- *                [--light-sampling distance|mis]
+ *                [--light-sampling distance|mis] [--background backdrop|lights]
  *
  * Renders the scene with the CPU path tracer (reference/pathtracer.h) and
  * writes an EXR with R, G, B, A and the standard error of each mean
@@ -26,6 +26,7 @@ typedef struct ref_args {
     const char *scene, *exr;
     long spp, max_order, width, height, seed, threads;
     int light_sampling; /* veil_pt_light_sampling */
+    int environment;    /* --background lights: the background lights the medium (a constant sky) */
 } ref_args;
 
 static int parse_args(int argc, char** argv, ref_args* a)
@@ -69,6 +70,13 @@ static int parse_args(int argc, char** argv, ref_args* a)
                 a->light_sampling = VEIL_PT_LIGHT_SAMPLING_MIS;
             else
                 return veil_cli_usage_error("--light-sampling: expected distance or mis, got '%s'", v);
+        } else if (!strcmp(s, "--background")) {
+            if (!strcmp(v, "backdrop"))
+                a->environment = 0;
+            else if (!strcmp(v, "lights"))
+                a->environment = 1;
+            else
+                return veil_cli_usage_error("--background: expected backdrop or lights, got '%s'", v);
         } else {
             return veil_cli_usage_error("unknown option '%s'", s);
         }
@@ -164,6 +172,7 @@ int veil_cmd_reference(int argc, char** argv)
     o.seed = (uint64_t)a.seed;
     o.threads = (int)a.threads;
     o.light_sampling = a.light_sampling;
+    o.environment = a.environment;
     if (isatty(fileno(stderr))) {
         o.progress = show_progress;
         o.progress_user = &prog;

@@ -1,6 +1,9 @@
 """Inside Blender 3.4 (bpy): a veil scene with one vdb source as a Cycles scene, rendered once.
 
-    blender -b --factory-startup --python bench/peers_cycles/blender_scene.py -- SCENE.json SPP SEED OUT.exr
+    blender -b --factory-startup --python bench/peers_cycles/blender_scene.py -- SCENE.json SPP SEED OUT.exr [sky]
+
+With `sky` the world is the scene's background colour (strength 1: radiance W m^-2 sr^-1, constant in
+every direction) and lights the medium, as `veil reference --background lights` has it; otherwise black.
 
 The lights, camera, black world and unbiased settings are bench/fog_truth/blender_setup.py's (its
 calibrations: Power = 4 pi I, Strength = E, vertical sensor fit, 0.01 px filter). The medium: the vdb
@@ -26,7 +29,9 @@ def attr_grid(src):
 
 
 def main():
-    scene_path, spp, seed, out = sys.argv[sys.argv.index("--") + 1:][:4]
+    argv = sys.argv[sys.argv.index("--") + 1:]
+    scene_path, spp, seed, out = argv[:4]
+    sky = len(argv) > 4 and argv[4] == "sky"
     with open(scene_path) as f:
         s = json.load(f)
     med = s["medium"]
@@ -36,6 +41,10 @@ def main():
     bpy.ops.wm.read_factory_settings(use_empty=True)
     sc = bpy.context.scene
     bs.black_world(sc)
+    if sky:
+        bg = sc.world.node_tree.nodes["Background"]
+        bg.inputs["Color"].default_value = tuple(s.get("background", {}).get("color", [0.0, 0.0, 0.0])) + (1.0,)
+        bg.inputs["Strength"].default_value = 1.0
     bs.add_lights(sc, s["lights"])
     bs.add_camera(sc, s["camera"])
     path = src["file"] if os.path.isabs(src["file"]) else os.path.join(os.path.dirname(scene_path), src["file"])
