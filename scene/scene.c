@@ -62,9 +62,14 @@ veil_result veil_scene_grid_set(veil_scene* s, const char* name, const float* da
     size_t bad = 0, first = 0;
     for (size_t i = 0; i < n; ++i)
         if (!isfinite(data[i]) && bad++ == 0) first = i;
-    if (bad)
+    if (bad) { /* the first one's index (i, j, k), from its offset in the caller's order */
+        size_t i, j, k, nx = (size_t)dims[0], ny = (size_t)dims[1], nz = (size_t)dims[2];
+        if (z_fastest) k = first % nz, j = first / nz % ny, i = first / nz / ny;
+        else i = first % nx, j = first / nx % ny, k = first / nx / ny;
         return veil_fail(err, VEIL_ERR_INVALID, "grid '%.200s': %zu value%s not finite (NaN or infinite), the first "
-                         "at offset %zu of %zu", name, bad, bad == 1 ? " is" : "s are", first, n);
+                         "at index [%zu, %zu, %zu] (offset %zu of %zu)", name, bad, bad == 1 ? " is" : "s are", i, j,
+                         k, first, n);
+    }
     float* copy = malloc(n * sizeof *copy);
     char* nm = malloc(strlen(name) + 1);
     veil_scene_grid* slot = (veil_scene_grid*)veil_scene_grid_find(s, name);

@@ -365,11 +365,15 @@ static void grids_from_memory(veil_context* ctx)
     g.index_to_world[12] = 0;
     g.data = NULL;
     CHECK(veil_scene_set_grid(a, "density", &g, &err) == VEIL_ERR_INVALID && strstr(err.msg, "data"), "NULL data");
-    float nan_grid[8] = {0, 0, 0, NAN, 0, 0, 0, 0};
+    float nan_grid[8] = {0, 0, 0, NAN, 0, 0, 0, 0}; /* offset 3 of a 2x2x2 grid: x fastest (1, 1, 0), z fastest (0, 1, 1) */
     g.data = nan_grid;
     CHECK(veil_scene_set_grid(a, "density", &g, &err) == VEIL_ERR_INVALID && strstr(err.msg, "not finite") &&
-              strstr(err.msg, "offset 3 of 8"),
+              strstr(err.msg, "index [1, 1, 0] (offset 3 of 8)"),
           "NaN: %s", err.msg);
+    g.axis_order = VEIL_AXIS_ORDER_Z_FASTEST;
+    CHECK(veil_scene_set_grid(a, "density", &g, &err) == VEIL_ERR_INVALID && strstr(err.msg, "index [0, 1, 1]"),
+          "NaN, z fastest: %s", err.msg);
+    g.axis_order = VEIL_AXIS_ORDER_X_FASTEST;
     veil_image* img = NULL;
     veil_render_desc rd = VEIL_RENDER_DESC_INIT;
     veil_result r;

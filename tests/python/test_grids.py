@@ -167,9 +167,9 @@ def test_non_finite_grid_value_is_reported(gl, grids_api):
     d[1, 2, 3] = np.inf
     with pytest.raises(veil.VeilError) as e:
         veil.render(scene(ARRAY), grids={"density": d})
-    # named: the grid, and where (its flat offset in the array as given, 3 + 8 (2 + 8 x 1), or its index)
+    # named: the grid, and where: its index [i, j, k] as the array is indexed (C order: offset 3 + 8 (2 + 8 x 1))
     assert "'density'" in e.value.message
-    assert "83" in e.value.message or "1, 2, 3" in e.value.message, e.value.message
+    assert "index [1, 2, 3] (offset 83 of 512)" in e.value.message, e.value.message
 
 
 def test_emission_grid_from_memory_equals_the_file(gl, grids_api, tmp_path):
