@@ -203,7 +203,10 @@ VEIL_API const float* veil_image_rgba(const veil_image* img);
  * integral), "single.R", "single.G", "single.B" (single scattering),
  * "depth" (mean distance of the first interaction, m),
  * "multiple.volume.R", ".G", ".B" (the volumetric multiple-scattering
- * estimate), "multiple.screen.R", ".G", ".B" (the screen-space spread);
+ * estimate), "multiple.screen.R", ".G", ".B" (the screen-space spread),
+ * "Z" (veil 0.3: depth along the camera's view axis, as compositors read
+ * Z: depth x the cosine of the pixel's ray to the axis; +infinity where
+ * the ray meets no medium);
  * R, G, B = T * background + single + multiple.volume + multiple.screen. VEIL_ERR_INVALID
  * for any other name. */
 VEIL_API veil_result veil_image_channel(const veil_image* img, const char* name, float* out, veil_error* err);

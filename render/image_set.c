@@ -1,5 +1,6 @@
 #include "image_set.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -8,7 +9,7 @@
 const char* const veil_image_set_channel_names[VEIL_IMAGE_SET_CHANNELS] = {
     "R", "G", "B", "A", "T.R", "T.G", "T.B", "P", "single.R", "single.G", "single.B", "depth",
     "multiple.volume.R", "multiple.volume.G", "multiple.volume.B",
-    "multiple.screen.R", "multiple.screen.G", "multiple.screen.B"};
+    "multiple.screen.R", "multiple.screen.G", "multiple.screen.B", "Z"};
 
 void veil_image_set_free(veil_image_set* s)
 {
@@ -19,6 +20,7 @@ void veil_image_set_free(veil_image_set* s)
     free(s->aov_v);
     free(s->aov_m);
     free(s->aov_q);
+    free(s->aov_z);
     memset(s, 0, sizeof *s);
 }
 
@@ -26,6 +28,10 @@ void veil_image_set_plane(const veil_image_set* s, int c, float* out)
 {
     const float* src;
     size_t n = (size_t)s->width * (size_t)s->height, k;
+    if (c == 18) { /* Z: one float a pixel */
+        for (size_t i = 0; i < n; ++i) out[i] = s->aov_z ? s->aov_z[i] : INFINITY;
+        return;
+    }
     if (c < 12) {
         src = c < 4 ? s->rgba : c < 8 ? s->aov_t : s->aov_s;
         k = (size_t)(c % 4);

@@ -16,6 +16,9 @@
  *          diffusion estimate; 0 when it is off); A unused
  *   aov_m  screen-space multiple scattering (R, G, B: the spread light;
  *          0 when the pass is off or skipped); A: the MIP level read
+ *   aov_z  (1 float a pixel) Z: the depth as compositors read it, along the
+ *          camera's view axis (depth x the cosine of the pixel's ray to the
+ *          axis), +infinity where the ray meets no medium
  *   aov_q  (not written to files) the screen-space pass's source: single
  *          scattering's light scattered, not absorbed, on its way to the
  *          camera (R, G, B), and the luminance-weighted P of it
@@ -35,15 +38,16 @@ typedef struct veil_image_set {
     float* aov_v;
     float* aov_m;
     float* aov_q;
+    float* aov_z;
 } veil_image_set;
 
 void veil_image_set_free(veil_image_set* s); /* accepts NULL and zeroed sets */
 
 /* The EXR channels an image set can hold, by name: "R", "G", "B", "A",
  * "T.R", "T.G", "T.B", "P", "single.R", "single.G", "single.B", "depth",
- * "multiple.volume.R", ".G", ".B", "multiple.screen.R", ".G", ".B"
- * (a zero plane when its buffer is NULL). */
-#define VEIL_IMAGE_SET_CHANNELS 18
+ * "multiple.volume.R", ".G", ".B", "multiple.screen.R", ".G", ".B", "Z"
+ * (a zero plane when its buffer is NULL; Z: +infinity, no medium). */
+#define VEIL_IMAGE_SET_CHANNELS 19
 extern const char* const veil_image_set_channel_names[VEIL_IMAGE_SET_CHANNELS];
 
 /* The plane of channel c (an index into the names above) into out

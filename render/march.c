@@ -219,6 +219,29 @@ int veil_march_band_rows(const veil_march_desc* d, int w, int h)
     return rows >= h ? h : (int)rows;
 }
 
+/* The image set's Z (render/image_set.h): the depth AOV, a distance along each pixel's ray, as a depth
+ * along the view axis (distance x the cosine of the pixel's ray to the axis: the camera's own rays,
+ * lens shift included), +infinity where the ray meets no medium (depth 0). */
+static veil_result planar_depth(const veil_march_desc* d, veil_image_set* out, veil_error* err)
+{
+    veil_camera_basis b;
+    veil_result r = veil_camera_make_basis(d->camera, d->width, d->height, &b, err);
+    if (r != VEIL_OK) return r;
+    size_t n = (size_t)d->width * (size_t)d->height;
+    out->aov_z = malloc(n * sizeof *out->aov_z);
+    if (!out->aov_z) return veil_fail(err, VEIL_ERR_OOM, "out of memory for a %dx%d depth plane", d->width, d->height);
+    for (int py = 0; py < d->height; ++py)
+        for (int px = 0; px < d->width; ++px) {
+            float dir[3];
+            veil_camera_ray(&b, d->width, d->height, px, py, dir);
+            double c = (double)dir[0] * b.fwd[0] + (double)dir[1] * b.fwd[1] + (double)dir[2] * b.fwd[2];
+            size_t i = (size_t)py * (size_t)d->width + (size_t)px;
+            float dist = out->aov_s[4 * i + 3];
+            out->aov_z[i] = dist > 0.0f ? (float)(dist * c) : INFINITY;
+        }
+    return VEIL_OK;
+}
+
 veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_set* out, veil_error* err)
 {
     veil_image_set_free(out);
@@ -322,6 +345,7 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         if (r == VEIL_OK) r = veil_gl_check("ray march (render/shaders/march.comp)", err);
         for (int i = 0; i < N && r == VEIL_OK; ++i)
             r = veil_gl_read_texture(tex[i], GL_RGBA, floats, *dst[i], "reading back the image", err);
+        if (r == VEIL_OK) r = planar_depth(d, out, err);
     }
     glDeleteTextures(N, tex);
     glDeleteTextures(1, &limit);

@@ -17,6 +17,7 @@ _AOVS = (
     ("transmittance", ("T.R", "T.G", "T.B")),
     ("density_integral", ("P",)),
     ("depth", ("depth",)),
+    ("z", ("Z",)),
     ("single", ("single.R", "single.G", "single.B")),
     ("multiple_volume", ("multiple.volume.R", "multiple.volume.G", "multiple.volume.B")),
     ("multiple_screen", ("multiple.screen.R", "multiple.screen.G", "multiple.screen.B")),
@@ -27,8 +28,11 @@ class Result(dict):
     """render()'s answer: a dict of float32 numpy arrays, each H x W x C, top row first.
 
     Keys: "rgba" (C=4), and unless aovs=False "transmittance" (3),
-    "density_integral" (1), "depth" (1), "single" (3), "multiple" (3: the
-    sum of the next two), "multiple_volume" (3), "multiple_screen" (3).
+    "density_integral" (1), "depth" (1: the mean distance of the first
+    interaction along the ray, 0 where none), "z" (1: that depth along the
+    view axis, +inf where no medium; needs veil 0.3), "single" (3),
+    "multiple" (3: the sum of the next two), "multiple_volume" (3),
+    "multiple_screen" (3).
 
     Attributes:
         width, height: the image size in pixels
@@ -244,6 +248,8 @@ def _image_arrays(img, aovs):
     if aovs:
         err = _err()
         for key, names in _AOVS:
+            if key == "z" and not _Lib.has_progress:  # Z came with veil 0.3, as the progress callback did
+                continue
             planes = np.empty((len(names), h, w), dtype=np.float32)
             for c, name in enumerate(names):
                 ptr = planes[c].ctypes.data_as(ctypes.POINTER(ctypes.c_float))

@@ -168,8 +168,9 @@ static void render_and_read(veil_context* ctx, const veil_scene* scene)
     for (int i = 0; i < w * h; ++i) alpha_same &= memcmp(&plane[i], &rgba[4 * i + 3], sizeof(float)) == 0;
     CHECK(alpha_same, "channel A is the rgba's alpha");
     CHECK(veil_image_channel(img, "depth", plane, &err) == VEIL_OK, "channel depth: %s", err.msg);
-    CHECK(veil_image_channel(img, "Z", plane, &err) == VEIL_ERR_INVALID, "channel Z is not one");
-    CHECK(strstr(err.msg, "'Z'") && strstr(err.msg, "single.R") && strstr(err.msg, "depth"),
+    CHECK(veil_image_channel(img, "Z", plane, &err) == VEIL_OK, "channel Z: %s", err.msg);
+    CHECK(veil_image_channel(img, "z", plane, &err) == VEIL_ERR_INVALID, "channel z (names are case-sensitive)");
+    CHECK(strstr(err.msg, "'z'") && strstr(err.msg, "single.R") && strstr(err.msg, "depth") && strstr(err.msg, "Z"),
           "message names the channel and lists the valid ones: %s", err.msg);
     CHECK(veil_image_channel(img, NULL, plane, &err) == VEIL_ERR_INVALID, "channel(NULL name)");
     CHECK(veil_image_channel(img, "R", NULL, &err) == VEIL_ERR_INVALID, "channel(NULL out)");

@@ -12,7 +12,7 @@ import pytest
 import veil
 from conftest import H, W, placement, scene, sphere, write_vdb
 
-CHANNELS = {"rgba": 4, "transmittance": 3, "density_integral": 1, "depth": 1, "single": 3, "multiple": 3,
+CHANNELS = {"rgba": 4, "transmittance": 3, "density_integral": 1, "depth": 1, "z": 1, "single": 3, "multiple": 3,
             "multiple_volume": 3, "multiple_screen": 3}
 
 
@@ -30,7 +30,8 @@ def test_outputs_shapes_dtypes_and_top_row_first(gl, tmp_path):
     for key, c in CHANNELS.items():
         a = out[key]
         assert a.dtype == np.float32 and a.shape == (H, W, c) and a.flags.c_contiguous, key
-        assert np.all(np.isfinite(a)), key
+        if key != "z":  # Z is +inf where no medium
+            assert np.all(np.isfinite(a)), key
     assert (out.width, out.height) == (W, H)
     alpha = out["rgba"][..., 3]
     # At 4 m with a 40 degree field of view, row r's ray climbs s = tan(20 deg) (1 - (r + 1/2) / 24) m per
@@ -41,6 +42,14 @@ def test_outputs_shapes_dtypes_and_top_row_first(gl, tmp_path):
     assert alpha[28:].max() == 0.0, "the bottom rows meet no medium: alpha exactly 0"
     assert np.all(out["depth"][28:] == 0.0) and out["depth"][: H // 4].min() > 2.0  # m from the camera
     assert np.all(out["transmittance"][28:] == 1.0)
+    # Z: the depth along the view axis, +inf where no medium; elsewhere depth x cos of the pixel's ray, so
+    # at most the depth and at least depth x cos(the corner's angle): tan(20 deg) up, aspect W/H across
+    z, depth = out["z"][..., 0], out["depth"][..., 0]
+    assert np.all(np.isposinf(z[depth == 0.0])) and not np.any(np.isinf(z[depth > 0.0]))
+    t = np.tan(np.radians(20.0))
+    cos_corner = 1.0 / np.sqrt(1.0 + t * t * (1.0 + (W / H) ** 2))
+    hit = depth > 0.0
+    assert np.all(z[hit] <= depth[hit] * (1 + 2.0 ** -22)) and np.all(z[hit] >= depth[hit] * cos_corner * (1 - 2.0 ** -22))
     # the outputs compose as veil.h says: rgba = T x background + single + multiple.volume + multiple.screen.
     # Four float32 terms summed on the GPU in its own order: each addition rounds by at most half an
     # ulp of the partial sum, so |rgba - sum| <= 3 * 2^-24 * (sum of the terms' magnitudes); 4 ulp here.
