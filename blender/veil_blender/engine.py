@@ -44,6 +44,7 @@ def depth_along_axis(distance, frame):
     """veil's ray distance (H x W, top row first, as veil gives it) -> depth along the view axis, 1e10
     where no medium (veil's distance 0).
 
+    Used with a library older than veil 0.3, which has no Z of its own.
     Pixel (column i, row r from the top) looks through the point (x, y, -1) of camera space, (x, y)
     its centre on the frame one metre ahead (export.camera_frame); its ray makes the angle theta with
     the view axis, cos theta = 1 / sqrt(1 + x^2 + y^2), and a point at distance d along the ray lies
@@ -168,7 +169,12 @@ class VeilRenderEngine(bpy.types.RenderEngine):
                                      % (rgba.shape[1], rgba.shape[0], width, height))
         put("Combined", rgba)
         if "Depth" in passes:
-            put("Depth", depth_along_axis(images["depth"][..., 0], self._frame)[..., None])
+            if "z" in images:  # veil's own Z (0.3): the depth along the view axis, +inf where no medium
+                import numpy as np
+                z = images["z"][..., 0]
+                put("Depth", np.where(np.isinf(z), np.float32(export.NO_DEPTH), z).astype(np.float32)[..., None])
+            else:  # an older library: the same from the ray distance here
+                put("Depth", depth_along_axis(images["depth"][..., 0], self._frame)[..., None])
         if scene.veil.use_aov_passes:
             for name, _, _, _, key in AOV_PASSES:
                 if key in images:

@@ -103,5 +103,12 @@ check(hit.any() and (~hit).any(), "depth: medium in %d pixels, none in %d" % (hi
 check(bool(np.all(got[~hit] == np.float32(1e10))), "pass Depth = 1e10 where no medium")
 check(float(rel[hit].max()) <= 2.0 ** -21, "pass Depth = veil's distance x cos(angle to the view axis), within 4 ulps "
       "(max relative difference %.3g)" % float(rel[hit].max()))
+# and it is veil's own Z (the CLI's --aovs channel), +inf there written as Blender's 1e10: bit for bit
+if "Z" in cli:
+    z = cli["Z"]
+    check(bool(np.array_equal(got, np.where(np.isinf(z), np.float32(1e10), z).astype(np.float32))),
+          "pass Depth = veil's Z channel (inf: 1e10), bit for bit")
+else:
+    check(False, "the CLI's EXR has no Z channel (veil 0.3 writes one with --aovs)")
 print("%d check(s) failed" % len(failures) if failures else "all checks passed")
 sys.exit(1 if failures else 0)
