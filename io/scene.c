@@ -6,6 +6,8 @@
 #include "json_read.h"
 #include "scene_multiple.h"
 #include "scene_sources.h"
+#include "image.h"
+#include "../scene/limits.h"
 
 #include <cJSON.h>
 #include <errno.h>
@@ -31,13 +33,17 @@ static const char* const REPRESENTATIONS[] = {"auto", "dense", "sparse", NULL}; 
 static const char* const PHASE_TYPES[] = {"isotropic", "hg", NULL}; /* = veil_phase_type */
 static const char* const ISO_KEYS[] = {"type", NULL};
 static const char* const HG_KEYS[] = {"type", "g", NULL};
-static const char* const LIGHT_TYPES[] = {"point", "directional", "spot", NULL}; /* = veil_light_type */
+/* = veil_light_type, and "environment" (scene/environment.h: not a veil_light) */
+static const char* const LIGHT_TYPES[] = {"point", "directional", "spot", "environment", NULL};
+#define ENVIRONMENT_KIND 3
 static const char* const POINT_KEYS[] = {"type", "position", "intensity", NULL};
 static const char* const DIR_KEYS[] = {"type", "direction", "irradiance", NULL};
 static const char* const SPOT_KEYS[] = {"type", "position", "direction", "intensity", "inner_angle_deg",
                                         "outer_angle_deg", NULL};
 static const char* const* const LIGHT_KEYS[] = {POINT_KEYS, DIR_KEYS, SPOT_KEYS}; /* by veil_light_type */
 static const char* const BACKGROUND_KEYS[] = {"color", NULL};
+static const char* const ENV_KEYS[] = {"type", "color", "file", "intensity", "rotation_deg", "up", "lights", NULL};
+static const char* const ENV_UP[] = {"y", "z", NULL};
 
 static veil_result check_camera(const ctx* c, const jpath* p, const veil_camera* cam)
 {
@@ -165,6 +171,97 @@ static veil_result parse_cone(const ctx* c, const cJSON* lo, const jpath* lp, ve
     return VEIL_OK;
 }
 
+/* The environment's map: an EXR's R, G, B (alpha ignored), times colour x intensity; NaN or infinite texels
+ * refused (naming the texel), negative ones (a filtered map's ringing) read as 0. */
+static veil_result load_environment_map(const ctx* c, const jpath* fp, veil_environment* env, const float tint[3])
+{
+    int w = 0, h = 0;
+    float* rgba = NULL;
+    veil_error inner = {0};
+    veil_result code = veil_read_exr(env->file, &w, &h, &rgba, &inner);
+    if (code != VEIL_OK) {
+        veil_result r = veil__jr_fail_at(c, fp, "cannot read the environment map: %s", inner.msg);
+        return code == VEIL_ERR_OOM || code == VEIL_ERR_LIMIT || code == VEIL_ERR_IO ? code : r;
+    }
+    if ((size_t)w * (size_t)h > VEIL_ENV_MAX_TEXELS || w < 2 || h < 1) {
+        free(rgba);
+        return veil__jr_fail_at(c, fp, "'%s': an environment map of %dx%d texels (a lat-long map from 2x1 to %zu "
+                                       "texels, twice as wide as high)", env->file, w, h, VEIL_ENV_MAX_TEXELS);
+    }
+    env->rgb = malloc((size_t)w * (size_t)h * 3 * sizeof *env->rgb);
+    if (!env->rgb) {
+        free(rgba);
+        return veil_fail(c->err, VEIL_ERR_OOM, "%s: out of memory for the environment map (%dx%d)", c->name, w, h);
+    }
+    env->width = w, env->height = h;
+    for (size_t t = 0; t < (size_t)w * (size_t)h; ++t)
+        for (int k = 0; k < 3; ++k) {
+            float v = rgba[4 * t + (size_t)k];
+            if (!isfinite(v)) {
+                free(rgba);
+                return veil__jr_fail_at(c, fp, "'%s': texel (%zu, %zu) has %c %s: radiance must be finite",
+                                        env->file, t % (size_t)w, t / (size_t)w, "RGB"[k], isnan(v) ? "NaN" : "inf");
+            }
+            double r = v > 0.0f ? (double)v * tint[k] : 0.0;
+            if (r > VEIL_MAX_BACKGROUND) {
+                free(rgba);
+                return veil__jr_fail_at(c, fp, "'%s': texel (%zu, %zu) times color x intensity is %g: radiance at "
+                                        "most %g (scene/limits.h)", env->file, t % (size_t)w, t / (size_t)w, r,
+                                        VEIL_MAX_BACKGROUND);
+            }
+            env->rgb[3 * t + (size_t)k] = (float)r;
+        }
+    free(rgba);
+    return VEIL_OK;
+}
+
+/* {"type": "environment", "color" | "file", "intensity", "rotation_deg", "lights"} (scene/environment.h) */
+static veil_result parse_environment(const ctx* c, const cJSON* e, const jpath* ep, veil_environment* env)
+{
+    static const range ROTATION = {-1e6, 1e6, false, false, false, "a number of degrees in [-1e6, 1e6]"};
+    static const range LIGHTS = {1, VEIL_MAX_LIGHTS, false, false, true, "an integer in [1, 16]"};
+    const jpath fp = {ep, "file", 0}, ip = {ep, "intensity", 0};
+    TRY(veil__jr_check_keys(c, e, ep, ENV_KEYS));
+    env->present = 1;
+    env->lights = VEIL_ENV_DEFAULT_LIGHTS;
+    float color[3] = {1.0f, 1.0f, 1.0f};
+    double intensity = 1.0, rotation = 0.0;
+    const int has_color = cJSON_GetObjectItemCaseSensitive(e, "color") != NULL;
+    TRY(veil__jr_get_floats_in(c, e, ep, "color", false, 3, &VEIL__R_BACKGROUND, color));
+    TRY(veil__jr_get_number(c, e, ep, "intensity", false, &VEIL__R_BACKGROUND, &intensity));
+    TRY(veil__jr_get_number(c, e, ep, "rotation_deg", false, &ROTATION, &rotation));
+    TRY(veil__jr_get_int(c, e, ep, "lights", &LIGHTS, &env->lights));
+    TRY(veil__jr_get_name(c, e, ep, "up", ENV_UP, &env->up_z));
+    TRY(veil__get_string(c, e, ep, "file", false, &env->file));
+    env->rotation_deg = (float)rotation;
+    float tint[3];
+    for (int k = 0; k < 3; ++k) tint[k] = (float)(color[k] * intensity);
+    if (env->file) {
+        TRY(veil__resolve_path(c, &fp, &env->file, 0));
+        TRY(load_environment_map(c, &fp, env, tint));
+    } else {
+        if (!has_color)
+            return veil__jr_fail_at(c, ep, "missing required field: \"color\" (a constant sky's radiance, "
+                                           "W m^-2 sr^-1) or \"file\" (a lat-long EXR map)");
+        env->rgb = malloc(3 * sizeof *env->rgb);
+        if (!env->rgb) return veil_fail(c->err, VEIL_ERR_OOM, "%s: out of memory", c->name);
+        env->width = env->height = 1;
+        for (int k = 0; k < 3; ++k) {
+            if ((double)tint[k] > VEIL_MAX_BACKGROUND)
+                return veil__jr_fail_at(c, &ip, "color x intensity is %g: radiance at most %g (scene/limits.h)",
+                                        (double)tint[k], VEIL_MAX_BACKGROUND);
+            env->rgb[k] = tint[k];
+        }
+    }
+    double total[3];
+    veil_env_integral(env, total);
+    for (int k = 0; k < 3; ++k)
+        if (total[k] > VEIL_MAX_LIGHT)
+            return veil__jr_fail_at(c, env->file ? &fp : ep, "the environment's radiance integrates to %g W/m^2 over "
+                                    "the sphere: at most %g, a light's limit (scene/limits.h)", total[k], VEIL_MAX_LIGHT);
+    return VEIL_OK;
+}
+
 static veil_result parse_lights(const ctx* c, const cJSON* root, veil_scene* s)
 {
     const jpath p = {NULL, "lights", 0};
@@ -172,14 +269,23 @@ static veil_result parse_lights(const ctx* c, const cJSON* root, veil_scene* s)
     size_t i = 0;
     TRY(veil__jr_get_container(c, root, &p, false, true, &arr));
     void* items = NULL;
+    size_t n = 0;
     TRY(veil__jr_alloc_items(c, &p, arr, sizeof *s->lights, VEIL_MAX_LIGHTS, &items, &s->light_count));
     s->lights = items;
     cJSON_ArrayForEach(e, arr) {
-        const jpath ep = {&p, NULL, i};
-        veil_light* l = &s->lights[i++];
+        const jpath ep = {&p, NULL, i++};
         int kind;
         if (!cJSON_IsObject(e)) return veil__jr_expected(c, &ep, "an object", e);
         TRY(veil__jr_get_kind(c, e, &ep, LIGHT_TYPES, &kind));
+        if (kind == ENVIRONMENT_KIND) {
+            if (s->environment.present)
+                return veil__jr_fail_at(c, &ep, "a second environment light (lights[%zu] is one): at most one is "
+                                                "supported", s->environment.light_index);
+            TRY(parse_environment(c, e, &ep, &s->environment));
+            s->environment.light_index = i - 1;
+            continue;
+        }
+        veil_light* l = &s->lights[n++];
         l->type = (veil_light_type)kind;
         TRY(veil__jr_check_keys(c, e, &ep, LIGHT_KEYS[kind]));
         if (kind != VEIL_LIGHT_DIRECTIONAL)
@@ -189,6 +295,11 @@ static veil_result parse_lights(const ctx* c, const cJSON* root, veil_scene* s)
         TRY(veil__jr_get_floats_in(c, e, &ep, power, true, 3, &VEIL__R_LIGHT, l->color));
         if (kind == VEIL_LIGHT_SPOT) TRY(parse_cone(c, e, &ep, l));
     }
+    s->light_count = n; /* (the environment is one of the VEIL_MAX_LIGHTS entries: n < VEIL_MAX_LIGHTS with it) */
+    if (s->environment.present && s->environment.lights > VEIL_MAX_LIGHTS - (int)n)
+        s->environment.lights = VEIL_MAX_LIGHTS - (int)n; /* (docs/scene-format.md: the room the other lights leave) */
+    if (s->environment.present)
+        s->environment.cut_count = veil_env_median_cut(&s->environment, s->environment.lights, s->environment.cut);
     return VEIL_OK;
 }
 
@@ -217,6 +328,7 @@ static veil_result parse_root(const ctx* c, const cJSON* root, veil_scene* s)
     int q = -1;
     TRY(veil__jr_get_name(c, root, NULL, "quality", QUALITIES, &q));
     s->quality = (veil_quality)(q + 1);
+    s->background_set = cJSON_GetObjectItemCaseSensitive(root, "background") != NULL;
     return parse_background(c, root, s->background);
 }
 

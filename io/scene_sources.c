@@ -67,8 +67,8 @@ static veil_result parse_random(const ctx* c, const cJSON* so, const jpath* sp, 
 }
 
 /* A string field; *out is a newly allocated copy (NULL when absent and optional). */
-static veil_result get_string(const ctx* c, const cJSON* o, const jpath* pp, const char* key, bool required,
-                              char** out)
+veil_result veil__get_string(const ctx* c, const cJSON* o, const jpath* pp, const char* key, bool required,
+                             char** out)
 {
     const jpath p = {pp, key, 0};
     const cJSON* v;
@@ -85,7 +85,7 @@ static veil_result get_string(const ctx* c, const cJSON* o, const jpath* pp, con
 /* `file` resolved against the scene's folder (c->base, else the scene
  * file's), and checked readable (unless `unchecked`: a sequence's pattern,
  * whose frames are checked as they are needed). */
-static veil_result resolve_path(const ctx* c, const jpath* fp, char** file, int unchecked)
+veil_result veil__resolve_path(const ctx* c, const jpath* fp, char** file, int unchecked)
 {
     const char* slash = strrchr(c->name, '/');
     const char* base = c->base ? c->base : c->name;
@@ -108,7 +108,7 @@ static veil_result resolve_path(const ctx* c, const jpath* fp, char** file, int 
     return VEIL_OK;
 }
 
-static veil_result resolve_file(const ctx* c, const jpath* fp, char** file) { return resolve_path(c, fp, file, 0); }
+static veil_result resolve_file(const ctx* c, const jpath* fp, char** file) { return veil__resolve_path(c, fp, file, 0); }
 
 /* "rbf": inline "particles", or a particle "file" (docs/particles.md) read now. */
 static veil_result parse_rbf(const ctx* c, const cJSON* so, const jpath* sp, veil_source* src)
@@ -125,7 +125,7 @@ static veil_result parse_rbf(const ctx* c, const cJSON* so, const jpath* sp, vei
         return parse_particles(c, so, sp, src);
     }
     char* path = NULL;
-    veil_result r = get_string(c, so, sp, "file", true, &path);
+    veil_result r = veil__get_string(c, so, sp, "file", true, &path);
     if (r == VEIL_OK) r = resolve_file(c, &fp, &path);
     if (r == VEIL_OK) {
         veil_error inner = {0};
@@ -177,13 +177,13 @@ static veil_result parse_grids(const ctx* c, const cJSON* so, const jpath* sp, v
 static veil_result parse_vdb(const ctx* c, const cJSON* so, const jpath* sp, veil_vdb_source* v)
 {
     const jpath fp = {sp, "file", 0};
-    TRY(get_string(c, so, sp, "file", true, &v->file));
+    TRY(veil__get_string(c, so, sp, "file", true, &v->file));
     int kind = veil_frame_pattern_kind(v->file);
     if (kind < 0)
         return veil__jr_fail_at(c, &fp, "'%s': a sequence's file holds the frame number once, as #### or %%04d "
                                 "(a literal '%%' is written %%%%)", v->file);
     if (kind == 1) { /* a sequence: frame 1's file until veil_scene_set_frame() says otherwise */
-        TRY(resolve_path(c, &fp, &v->file, 1));
+        TRY(veil__resolve_path(c, &fp, &v->file, 1));
         v->sequence = v->file;
         v->file = NULL;
         double off = 0.0;
@@ -217,13 +217,13 @@ static veil_result parse_array(const ctx* c, const cJSON* so, const jpath* sp, v
 static veil_result parse_grids(const ctx* c, const cJSON* so, const jpath* sp, veil_vdb_source* v, int array)
 {
     const jpath lp = {sp, "level_set", 0};
-    TRY(get_string(c, so, sp, "grid", array != 0, &v->grid));
+    TRY(veil__get_string(c, so, sp, "grid", array != 0, &v->grid));
     TRY(parse_transform(c, so, sp, v));
     double scale = 1.0;
     TRY(veil__jr_get_number(c, so, sp, "density_scale", false, &VEIL__R_DENSITY, &scale));
     v->density_scale = (float)scale;
     char* ls = NULL;
-    TRY(get_string(c, so, sp, "level_set", false, &ls));
+    TRY(veil__get_string(c, so, sp, "level_set", false, &ls));
     if (ls && strcmp(ls, "to_fog") != 0) {
         veil_result r = veil__jr_fail_at(c, &lp, "expected \"to_fog\" (convert a level set into a fog volume), got \"%s\"", ls);
         free(ls);
@@ -237,7 +237,7 @@ static veil_result parse_grids(const ctx* c, const cJSON* so, const jpath* sp, v
     TRY(veil__jr_get_container(c, so, &tp, false, false, &to));
     if (to) {
         TRY(veil__jr_check_keys(c, to, &tp, TEMPERATURE_KEYS));
-        TRY(get_string(c, to, &tp, "grid", true, &v->temperature_grid));
+        TRY(veil__get_string(c, to, &tp, "grid", true, &v->temperature_grid));
         double ts = 1.0, toff = 0.0, ti = -1.0;
         TRY(veil__jr_get_number(c, to, &tp, "scale", false, &VEIL__R_KELVIN, &ts));
         TRY(veil__jr_get_number(c, to, &tp, "offset", false, &VEIL__R_KELVIN, &toff));
@@ -250,7 +250,7 @@ static veil_result parse_grids(const ctx* c, const cJSON* so, const jpath* sp, v
     TRY(veil__jr_get_container(c, so, &ep, false, false, &eo));
     if (!eo) return VEIL_OK;
     TRY(veil__jr_check_keys(c, eo, &ep, EMISSION_KEYS));
-    TRY(get_string(c, eo, &ep, "grid", true, &v->emission_grid));
+    TRY(veil__get_string(c, eo, &ep, "grid", true, &v->emission_grid));
     double es = 1.0;
     TRY(veil__jr_get_number(c, eo, &ep, "scale", false, &VEIL__R_EMISSION, &es));
     v->emission_scale = (float)es;

@@ -121,6 +121,7 @@ void veil_scene_free(veil_scene* s)
     }
     free(s->grids);
     free(s->lights);
+    veil_env_free(&s->environment);
     free(s->path);
     free(s->base_dir);
     memset(s, 0, sizeof *s);

@@ -16,6 +16,7 @@
 
 #include "../core/result.h"
 #include "../core/shared.glsl.h"
+#include "environment.h"
 #include "light.h"
 #include "particle.h"
 
@@ -261,6 +262,8 @@ typedef struct veil_scene {
     veil_light* lights; /* owned */
     size_t light_count;
     float background[3]; /* linear RGB radiance seen through the medium */
+    int background_set;  /* 1: "background" was given (with an environment: seen instead of it) */
+    veil_environment environment; /* a light of type "environment" (at most one; not in `lights`) */
     veil_multiple multiple;
     veil_quality quality; /* "quality": UNSET when absent */
     veil_scene_grid* grids; /* owned; grid_count of them */
@@ -268,6 +271,12 @@ typedef struct veil_scene {
 } veil_scene;
 
 void veil_scene_free(veil_scene* s); /* accepts NULL and zeroed scenes */
+
+/* The lights the GPU pipeline carries: the scene's, and the environment's directional lights (its median cut). */
+static inline size_t veil_scene_light_total(const veil_scene* s)
+{
+    return s->light_count + (size_t)(s->environment.present ? s->environment.cut_count : 0);
+}
 
 /* Copies a grid into s under `name`, replacing one of the same name (an
  * "array" source reads it). Checks the dimensions (each >= 1, the product

@@ -451,7 +451,7 @@ static const bad_case BAD[] = {
     {"{" CAM "," MED ",'lights':[{'type':'directional','direction':[0,0,0],'irradiance':[1,1,1]}]}",
      VEIL_ERR_INVALID, "lights[0].direction", "expected a non-zero vector"},
     {"{" CAM "," MED ",'lights':[{'type':'area','position':[0,0,0],'intensity':[1,1,1]}]}",
-     VEIL_ERR_INVALID, "lights[0].type", "expected one of \"point\", \"directional\", \"spot\", got a string"},
+     VEIL_ERR_INVALID, "lights[0].type", "expected one of \"point\", \"directional\", \"spot\", \"environment\", got a string"},
     {"{" CAM "," MED ",'lights':[{'type':'point','direction':[0,0,1],'intensity':[1,1,1]}]}",
      VEIL_ERR_INVALID, "lights[0].direction", "unknown key (expected one of: type, position, intensity)"},
     {"{" CAM "," MED ",'lights':[{'type':'directional','direction':[0,0,1]}]}", VEIL_ERR_INVALID,

@@ -1,0 +1,107 @@
+/* veil — light from the environment: a constant sky or a lat-long map of
+ * radiance around the scene, at infinity (a scene file's light of type
+ * "environment", docs/scene-format.md). Pure math, no file format: io/scene.c
+ * reads the map (an EXR) into a veil_environment, and these functions give
+ *  - the radiance arriving from a direction (the background seen through
+ *    the medium, and what the reference path tracer's paths meet);
+ *  - the map as a few directional lights (median cut: Debevec, "A Median Cut
+ *    Algorithm for Light Probe Sampling", SIGGRAPH 2005 poster / 2006),
+ *    which is how the GPU pipeline carries it: each region of the sphere
+ *    becomes one directional light with the region's irradiance, so the
+ *    light-space optical depth, the light cache and the march need nothing
+ *    new;
+ *  - a distribution of directions proportional to the map's luminance
+ *    times solid angle, with its pdf, for the reference's importance
+ *    sampling (multiple importance sampling with the phase function).
+ *
+ * The map. Texel (i, j) of a W x H map (row j = 0 the top) holds the radiance
+ * (W m^-2 sr^-1, linear RGB) arriving from every direction of its cell: the
+ * map is piecewise constant, no interpolation (so that the median cut's sums,
+ * the sampling pdf and the lookups agree exactly). Directions in veil's
+ * world, +Y up, `d` the unit direction towards the sky (where light comes
+ * from), before rotation:
+ *     theta = acos(d.y) in [0, pi]          (row: v = theta / pi, from the top)
+ *     phi   = atan2(d.z, d.x) + pi in [0, 2 pi)   (column: u = phi / (2 pi))
+ * so the map's middle column looks along +X, a quarter in along -Z and three
+ * quarters along +Z: with veil's axes turned into Blender's (Blender
+ * (x, y, z) = veil (x, -z, y)) this is Blender's equirectangular
+ * environment texture, read with "Closest" interpolation. The texel's cell
+ * spans phi in [2 pi i / W, 2 pi (i+1) / W) and theta in [pi j / H, pi (j+1) / H):
+ * its solid angle is (2 pi / W) (cos(pi j / H) - cos(pi (j+1) / H)).
+ *
+ * Rotation: the whole map turned by rotation_deg about +Y (right-handed:
+ * +90 brings what was along +X to -Z). Intensity multiplies every texel.
+ * A constant sky is a 1 x 1 map.
+ *
+ * Up "z" (a scene written in a Z-up world, as Blender's add-on writes it):
+ * the world's +Z is the zenith, and world direction (x, y, z) looks the map
+ * up as (x, z, -y) would above: Blender's own equirectangular convention in
+ * Blender's own axes. The rotation is then about +Z (right-handed: +90
+ * brings +X to +Y).
+ */
+#ifndef VEIL_ENVIRONMENT_H
+#define VEIL_ENVIRONMENT_H
+
+#include <stddef.h>
+
+#include "../core/result.h"
+#include "light.h"
+
+#define VEIL_ENV_DEFAULT_LIGHTS 8 /* directional lights the GPU pipeline carries it as (docs/accuracy.md) */
+#define VEIL_ENV_MAX_TEXELS ((size_t)1 << 25) /* an 8K map, 8192 x 4096 */
+
+typedef struct veil_env_dist veil_env_dist;
+
+typedef struct veil_environment {
+    int present;       /* 0: none (every other field zero) */
+    int width, height; /* the map; 1 x 1: a constant sky */
+    float* rgb;        /* width * height * 3 radiances, intensity included (owned) */
+    float rotation_deg;
+    int up_z;          /* 1: "up": "z", the world's +Z is the map's zenith (0: +Y) */
+    int lights;        /* "lights": how many directional lights the GPU pipeline carries it as, 1..VEIL_MAX_LIGHTS */
+    char* file;        /* the map's file, resolved (owned); NULL: a constant colour */
+    size_t light_index; /* where it stood among the scene file's lights (for messages) */
+    veil_env_dist* dist; /* the sampling distribution, made on first need (veil_env_dist_make; owned) */
+    veil_light cut[VEIL_MAX_LIGHTS]; /* veil_env_median_cut's `lights` lights, made once when the scene is read */
+    int cut_count;
+} veil_environment;
+
+/* Releases what e owns; leaves it zeroed. */
+void veil_env_free(veil_environment* e);
+
+/* The radiance arriving from unit direction d (towards the sky), rgb. */
+void veil_env_radiance(const veil_environment* e, const double d[3], double out[3]);
+
+/* Texel (i, j)'s solid angle (sr) in a map h rows high and w wide. */
+double veil_env_texel_solid_angle(int w, int h, int j);
+
+/* The integral of the radiance over the sphere, rgb (W/m^2: the irradiance
+ * a sphere's point would get from all of it, cos left out). */
+void veil_env_integral(const veil_environment* e, double out[3]);
+
+/* The median cut: up to `max` regions of the map, each as a directional
+ * light whose irradiance is the region's integral of radiance over solid
+ * angle and whose direction is the region's luminance-weighted mean
+ * direction (rotation applied). Regions are split, the one carrying the
+ * most luminance first, across their longer side (in angle, the width
+ * weighted by the sine of the middle row's theta) at the texel boundary
+ * that halves the luminance most evenly; regions without light make no
+ * light. A constant sky is cut as a 64 x 32 map of itself. Returns the
+ * number of lights written (0 when the environment is black); the sum of
+ * their irradiances is veil_env_integral's, up to rounding. */
+int veil_env_median_cut(const veil_environment* e, int max, veil_light* out);
+
+/* Importance sampling by luminance x solid angle (a texel chosen with
+ * probability proportional to its luminance times its solid angle, then a
+ * direction uniform in solid angle within it). A black map samples the
+ * sphere uniformly. veil_env_dist_make: VEIL_ERR_OOM only. */
+veil_result veil_env_dist_make(veil_environment* e, veil_error* err);
+/* Releases e's sampling tables only (e->dist), leaving the rest. */
+void veil_env_dist_free(veil_environment* e);
+/* A direction d (unit, towards the sky, rotation applied) from uniforms
+ * u1, u2, u3 in [0, 1); returns its pdf (per steradian), > 0. */
+double veil_env_sample(const veil_environment* e, double u1, double u2, double u3, double d[3]);
+/* The pdf (per steradian) with which veil_env_sample gives direction d. */
+double veil_env_pdf(const veil_environment* e, const double d[3]);
+
+#endif
