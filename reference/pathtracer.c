@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "../scene/camera.h"
+#include "../scene/environment.h"
 #include "../scene/light.h"
 #include "pt_internal.h"
 
@@ -119,6 +120,8 @@ typedef struct pt_job {
     int mis;               /* light_sampling resolved to MIS */
     int may_vary;          /* a sample can differ from 0 once its ray meets medium (see render_pixel) */
     int needs_collision;   /* a sample is 0 unless the camera walk collides (no equiangular light) */
+    const veil_environment* env; /* the scene's environment light with its sampling tables, or NULL */
+    int env_behind;        /* 1: the environment is what the camera sees behind the medium (no "background") */
     veil_camera_basis cam;
     int w, h;
     float *rgba, *se;
@@ -276,6 +279,43 @@ static void next_event(const pt_job* j, const pt_segment* sg, const double pos[3
     }
 }
 
+/* The environment light at the walk's scattering vertex x, the path arriving along dir, times beta: two
+ * samples, one of the map (luminance x solid angle, scene/environment.h) and one of the phase function,
+ * each with its transmittance to infinity (ratio tracking) and combined by the power heuristic
+ * (Veach 1997): w_s = p_s^2 / (p_e^2 + p_p^2) for the strategy s that drew the direction. A sun in the map
+ * is found by the map's samples, a smooth sky seen through a peaked phase function by the phase's. Both
+ * are taken here, at the vertex, rather than the phase's one when the walk escapes: so every order the
+ * walk reaches, the last included, gets both (the walk stops at max_order). */
+static void environment_at(const pt_job* j, const double x[3], const double dir[3], const double beta[3], pt_rng* rng,
+                           double L[3], pt_counters* c)
+{
+    const veil_environment* env = j->env;
+    double w[3], T[3], Le[3];
+    /* (a) the map (with light_sampling DISTANCE, the phase function's sample alone, weight 1: the check that
+     * the map's sampling and its pdf are right, an estimator without them of the same value) */
+    const int both = j->mis;
+    if (both) {
+        double pe = veil_env_sample(env, pt_uniform(rng), pt_uniform(rng), pt_uniform(rng), w);
+        double pp = phase_hg(w[0] * dir[0] + w[1] * dir[1] + w[2] * dir[2], j->g);
+        veil_env_radiance(env, w, Le);
+        if ((Le[0] > 0.0 || Le[1] > 0.0 || Le[2] > 0.0) && pe > 0.0) {
+            veil__pt_transmittance(j->m, x, w, INFINITY, rng, T, c);
+            double f = pp / pe * (pe * pe / (pe * pe + pp * pp));
+            for (int k = 0; k < 3; ++k) L[k] += beta[k] * Le[k] * T[k] * f;
+        }
+    }
+    /* (b) the phase function: its value over its pdf is 1 */
+    veil_pt_sample_hg(dir, j->g, pt_uniform(rng), pt_uniform(rng), w);
+    double pp = phase_hg(w[0] * dir[0] + w[1] * dir[1] + w[2] * dir[2], j->g);
+    double pe = both ? veil_env_pdf(env, w) : 0.0;
+    veil_env_radiance(env, w, Le);
+    if ((Le[0] > 0.0 || Le[1] > 0.0 || Le[2] > 0.0) && pp > 0.0) {
+        veil__pt_transmittance(j->m, x, w, INFINITY, rng, T, c);
+        double f = pp * pp / (pe * pe + pp * pp);
+        for (int k = 0; k < 3; ++k) L[k] += beta[k] * Le[k] * T[k] * f;
+    }
+}
+
 /* One sample of the radiance along the camera ray (o, d); *t_hat gets the
  * estimate of the camera ray's transmittance per channel (stochastic
  * background only). */
@@ -311,12 +351,20 @@ static void trace(const pt_job* j, const double o[3], const double d[3], pt_rng*
             if (depth == 0) memcpy(t_hat, beta, sizeof beta);
             int counts = depth == 0 ? j->o->stochastic_background
                                     : j->o->environment && (max_order == 0 || depth <= max_order);
-            if (counts)
+            if (counts && depth == 0 && j->env_behind) {
+                double Le[3];
+                veil_env_radiance(j->env, dir, Le);
+                for (int k = 0; k < 3; ++k) L[k] += beta[k] * Le[k];
+            } else if (counts)
                 for (int k = 0; k < 3; ++k) L[k] += beta[k] * j->s->background[k];
             return;
         }
         if (ev != PT_SCATTER) return;
         next_event(j, &sg, pos, dir, t, beta0, beta, rng, L, c);
+        if (j->env) {
+            double x[3] = {pos[0] + t * dir[0], pos[1] + t * dir[1], pos[2] + t * dir[2]};
+            environment_at(j, x, dir, beta, rng, L, c);
+        }
         for (int k = 0; k < 3; ++k) pos[k] += t * dir[k];
         if (max_order > 0 && depth + 1 >= max_order) return;
         if (depth + 1 >= PT_RR_DEPTH) {
@@ -371,7 +419,9 @@ static void render_pixel(pt_job* j, int px, int py, pt_counters* c, uint64_t* dr
     double T[3];
     veil__pt_transmittance_exact(j->m, o, d, INFINITY, T);
     if (!j->o->stochastic_background) {
-        for (int k = 0; k < 3; ++k) mean[k] += T[k] * j->s->background[k];
+        double behind[3] = {j->s->background[0], j->s->background[1], j->s->background[2]};
+        if (j->env_behind) veil_env_radiance(j->env, d, behind);
+        for (int k = 0; k < 3; ++k) mean[k] += T[k] * behind[k];
         mean[3] = (T[0] + T[1] + T[2]) / 3.0;
     }
     /* a sample is 0 (or the background estimate 1 * background) for sure
@@ -462,6 +512,25 @@ veil_result veil_pt_render(const veil_pt_medium* m, const veil_scene* s, const v
     j->mis = sampling == VEIL_PT_LIGHT_SAMPLING_MIS;
     /* emission: scattered emission varies, and direct emission needs no collision */
     j->may_vary = opts->environment || opts->stochastic_background || m->emission[0] != NULL;
+    veil_environment env; /* the scene's, with sampling tables of its own (s is the caller's, const) */
+    memset(&env, 0, sizeof env);
+    if (s->environment.present) {
+        if (opts->environment) {
+            free(j);
+            return veil_fail(err, VEIL_ERR_INVALID, "the scene has an environment light (lights[%zu]): the "
+                             "background cannot light the medium as well", s->environment.light_index);
+        }
+        env = s->environment;
+        env.dist = NULL;
+        r = veil_env_dist_make(&env, err);
+        if (r != VEIL_OK) {
+            free(j);
+            return r;
+        }
+        j->env = &env;
+        j->env_behind = !s->background_set;
+        j->may_vary = 1;
+    }
     j->needs_collision = !opts->stochastic_background && m->emission[0] == NULL;
     for (size_t l = 0; l < s->light_count; ++l) {
         j->may_vary |= !is_dark(&s->lights[l]);
@@ -480,6 +549,7 @@ veil_result veil_pt_render(const veil_pt_medium* m, const veil_scene* s, const v
         free(j->rgba);
         free(j->se);
         free(j);
+        veil_env_dist_free(&env);
         return veil_fail(err, VEIL_ERR_OOM, "out of memory for a %dx%d image", w, h);
     }
     double t0 = now_ms();
@@ -530,5 +600,6 @@ veil_result veil_pt_render(const veil_pt_medium* m, const veil_scene* s, const v
     *rgba = j->rgba;
     *stderr_rgb = j->se;
     free(j);
+    veil_env_dist_free(&env);
     return VEIL_OK;
 }

@@ -15,7 +15,10 @@
  *    [F(sigma_t D sin g, xi_1) - F(sigma_t D sin g, g/2)], F(u, v) =
  *    int_0^v exp(-u tan x) dx (derived in airlight() below);
  *  - albedo 1 (white furnace): a medium lit by a uniform background of
- *    radiance 1 and absorbing nothing shows radiance 1 everywhere;
+ *    radiance 1 and absorbing nothing shows radiance 1 everywhere; the same
+ *    with an environment light of radiance 1 (MIS of the map and the phase);
+ *  - a map lit only in a small cap overhead against a directional light of
+ *    its irradiance (its width's effect bounded in test_env_sun);
  *  - Henyey-Greenstein sampling: a chi-square test on equal-probability
  *    bins of the analytic CDF (bin edges by bisection on the CDF, not by the
  *    sampler's inverse).
@@ -262,6 +265,105 @@ static void test_furnace(const char* what, double g, double scale, int spp)
     veil_scene_free(&s);
 }
 
+/* ---- the environment light (scene/environment.h) ---------------------------------- */
+
+/* One pixel as render1, with the environment sampled as `sampling` says (MIS: the map and the phase
+ * function; DISTANCE: the phase function alone). */
+static void render_env(const veil_pt_medium* m, const veil_scene* s, int spp, int max_order, int sampling,
+                       double mean[4], double se[3])
+{
+    veil_pt_opts o = {0};
+    o.width = o.height = 1;
+    o.spp = spp;
+    o.max_order = max_order;
+    o.seed = 11;
+    o.light_sampling = sampling;
+    float *rgba = NULL, *e = NULL;
+    veil_error err = {0};
+    veil_pt_stats st;
+    CHECK(veil_pt_render(m, s, &o, &rgba, &e, &st, &err) == VEIL_OK, "render: %s", err.msg);
+    for (int c = 0; c < 4; ++c) mean[c] = rgba ? rgba[c] : NAN;
+    for (int c = 0; c < 3; ++c) se[c] = e ? e[c] : NAN;
+    free(rgba);
+    free(e);
+}
+
+/* The white furnace lit by an environment light of radiance 1 (not the background): every pixel 1, with
+ * the map's samples and the phase's combined by MIS, and with the phase's alone. */
+static void test_env_furnace(void)
+{
+    veil_scene s = test_parse_scene(
+        "{\"camera\":{\"position\":[0.2,0.1,-3],\"look_at\":[0,0,0],\"width\":1,\"height\":1},"
+        "\"medium\":{\"sigma_a\":[0,0,0],\"sigma_s\":[0.5,1,2],\"phase\":{\"type\":\"hg\",\"g\":0.6},"
+        "\"max_resolution\":32,\"sources\":[{\"type\":\"rbf\",\"particles\":[{\"center\":[0,0,0],"
+        "\"amplitude\":3.0,\"sharpness\":2.0}]}]},"
+        "\"lights\":[{\"type\":\"environment\",\"color\":[1,1,1]}]}");
+    veil_pt_medium* m = NULL;
+    veil_error err = {0};
+    CHECK(veil_pt_medium_from_scene(&s, &m, &err) == VEIL_OK, "%s", err.msg);
+    double want[3] = {1, 1, 1}, mean[4], se[3];
+    render_env(m, &s, 40000, 0, VEIL_PT_LIGHT_SAMPLING_MIS, mean, se);
+    within_4_sigma("environment furnace, MIS", mean, se, want, NULL);
+    render_env(m, &s, 40000, 0, VEIL_PT_LIGHT_SAMPLING_DISTANCE, mean, se);
+    within_4_sigma("environment furnace, phase alone", mean, se, want, NULL);
+    veil_pt_medium_free(m);
+    veil_scene_free(&s);
+}
+
+/* test_sun_single's slab lit by a map whose only light is a cap around +Y: its first J of H rows (a
+ * polar cap of half-angle theta_c = pi J / H, radiance Lc), against the closed form of a directional
+ * light of the cap's irradiance E = Lc 2 pi (1 - cos theta_c) shining straight down. The map is sampled
+ * (MIS: a 0.35-degree cap is found by the map's samples; the phase's almost never find it). What the
+ * cap's width changes, bounded and added to the tolerance:
+ *  - the phase function, p(mu) at mu = cos(scattering angle) = omega . x_hat within sin(theta_c) of 0:
+ *    its first-order term averages to 0 over the cap (symmetric about +Y: whole rows), the rest is at
+ *    most (1/2) max|p''| sin^2(theta_c), relative to p(0): p = k (a - b mu)^(-3/2), a = 1 + g^2,
+ *    b = 2g, p'' = (15/4) b^2 k (a - b mu)^(-7/2);
+ *  - the optical depth to the slab's top, D / cos(theta) instead of D: T changes by at most a relative
+ *    sigma_t D (1 / cos(theta_c) - 1);
+ *  - points of the chord within D tan(theta_c) of its ends may see the light leave by a side face
+ *    instead: at most that share of the chord, 2 D tan(theta_c) / C, of the whole value. */
+static void test_env_sun(void)
+{
+    veil_scene s = test_parse_scene(
+        "{\"camera\":{\"position\":[-3,1,1],\"look_at\":[1,1,1],\"width\":1,\"height\":1},"
+        "\"medium\":{\"sigma_a\":[0.1,0.3,0.0],\"sigma_s\":[0.5,0.2,0.9],\"phase\":{\"type\":\"hg\",\"g\":0.3},"
+        "\"sources\":[]},\"lights\":[{\"type\":\"environment\",\"color\":[1,1,1]}],"
+        "\"background\":{\"color\":[0.2,0.2,0.2]}}");
+    const int W = 2048, H = 1024, J = 2;
+    const double Lc[3] = {2000, 3000, 4000};
+    veil_environment* env = &s.environment;
+    free(env->rgb);
+    env->rgb = calloc((size_t)W * H * 3, sizeof *env->rgb);
+    CHECK(env->rgb != NULL, "out of memory");
+    if (!env->rgb) return;
+    env->width = W, env->height = H;
+    for (int j = 0; j < J; ++j)
+        for (int i = 0; i < W; ++i)
+            for (int c = 0; c < 3; ++c) env->rgb[3 * ((size_t)j * W + i) + c] = (float)Lc[c];
+    veil_grid g = {{4, 4, 4}, {0, 0, 0}, 0.5f};
+    float rho[64];
+    for (int i = 0; i < 64; ++i) rho[i] = 1.0f;
+    veil_pt_medium* m = NULL;
+    veil_error err = {0};
+    CHECK(veil_pt_medium_from_density(&s, &g, rho, &m, &err) == VEIL_OK, "%s", err.msg);
+    const double gg = 0.3, p0 = (1 - gg * gg) / (4 * VEIL_PI * pow(1 + gg * gg, 1.5)), D = 0.75, C = 1.5;
+    const double tc = VEIL_PI * J / H, a = 1 + gg * gg, b = 2 * gg;
+    const double p2 = 3.75 * b * b * (1 - gg * gg) / (4 * VEIL_PI) * pow(a - b * sin(tc), -3.5);
+    double want[3], extra[3], mean[4], se[3];
+    for (int c = 0; c < 3; ++c) {
+        double st_c = (double)s.medium.sigma_a[c] + s.medium.sigma_s[c];
+        double E = Lc[c] * 2 * VEIL_PI * (1 - cos(tc));
+        double lit = s.medium.sigma_s[c] * p0 * E * exp(-st_c * D) * (1 - exp(-st_c * C)) / st_c;
+        want[c] = lit + s.background[c] * exp(-st_c * C);
+        extra[c] = lit * (0.5 * p2 * sin(tc) * sin(tc) / p0 + st_c * D * (1 / cos(tc) - 1) + 2 * D * tan(tc) / C);
+    }
+    render_env(m, &s, 40000, 1, VEIL_PT_LIGHT_SAMPLING_MIS, mean, se);
+    within_4_sigma("environment: a cap overhead, single", mean, se, want, extra);
+    veil_pt_medium_free(m);
+    veil_scene_free(&s);
+}
+
 /* ---- HG sampling -------------------------------------------------------------------- */
 
 /* The HG CDF in mu = cos(theta) from -1 (g != 0), and 1-2u inverse for g = 0. */
@@ -374,6 +476,8 @@ int main(void)
     test_airlight();
     test_furnace("white furnace, g = 0.6", 0.6, 1.0, 40000);
     test_furnace("white furnace, g = -0.8, dense", -0.8, 4.0, 160000);
+    test_env_furnace();
+    test_env_sun();
     static const double gs[] = {-0.99, -0.7, -0.3, 0.0, 1e-4, 0.1, 0.5, 0.9, 0.99};
     for (size_t i = 0; i < sizeof gs / sizeof gs[0]; ++i) test_hg_sampling(gs[i]);
     test_determinism();
