@@ -87,6 +87,19 @@ static void explain_lights(text* t, const veil_frame_plan* p)
                                                                    : "dropped: its cone misses the volume";
         put(t, "light %-3zu  %-11s %s\n", l, light_type_name(li->type), why);
     }
+    const veil_environment* env = &s->environment;
+    if (env->present) {
+        int used = 0;
+        for (int c = 0; c < env->cut_count; ++c, ++k) used += k < p->light_count && !memcmp(&p->lights[k], &env->cut[c], sizeof env->cut[c]);
+        put(t, "light %-3zu  environment %s: %d directional light%s of its median cut (lights %d)%s\n", env->light_index,
+            env->file ? env->file : "(a constant sky)", used, used == 1 ? "" : "s", env->lights,
+            env->cut_count == 0 ? "; black, lights nothing" : used < env->cut_count ? "; the rest: no medium" : "");
+        for (int c = 0; c < env->cut_count; ++c) {
+            const veil_light* L = &env->cut[c];
+            put(t, "           cut %-2d direction [%.9g, %.9g, %.9g] irradiance [%.9g, %.9g, %.9g]\n", c, L->direction[0],
+                L->direction[1], L->direction[2], L->color[0], L->color[1], L->color[2]);
+        }
+    }
 }
 
 /* Opens the volume as the files' headers describe it (no density reaches a GPU) into f's plan. */

@@ -83,6 +83,9 @@ int veil_render_lights(const veil_scene* s, const veil_grid* g, veil_light* out)
     if (!g && count_fogs(s) == 0) return 0; /* no medium at all */
     for (size_t l = 0; l < s->light_count && n < VEIL_MAX_LIGHTS; ++l)
         if (light_reaches(&s->lights[l], g)) out[n++] = s->lights[l];
+    /* the environment as directional lights, after the scene's (scene/environment.h: the median cut) */
+    for (int l = 0; l < s->environment.cut_count && n < VEIL_MAX_LIGHTS; ++l)
+        if (light_reaches(&s->environment.cut[l], g)) out[n++] = s->environment.cut[l];
     return n;
 }
 
@@ -103,7 +106,7 @@ static veil_opv_params opv_params(const veil_scene* s, const veil_render_opts* o
         /* what the device's budget leaves the suns' grids beside the EV and the rgba32f optical depths
          * veil_ev_check_budget counted (one per four lights, and one more) */
         double voxels = (double)g->dims[0] * g->dims[1] * g->dims[2];
-        int n = (int)s->light_count < VEIL_MAX_LIGHTS ? (int)s->light_count : VEIL_MAX_LIGHTS;
+        int n = (int)veil_scene_light_total(s) < VEIL_MAX_LIGHTS ? (int)veil_scene_light_total(s) : VEIL_MAX_LIGHTS;
         double used = voxels * 4.0 + voxels * 16.0 * ((n + 3) / 4 + 1);
         p.sun_bytes = (double)budget > used ? (double)budget - used : 1.0;
     }

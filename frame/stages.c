@@ -155,7 +155,7 @@ static veil_result inject_build(veil_frame* f, veil_stage_report* rep, veil_erro
         if (f->gpu) res = f->gpu(f, err);
         forget_volume(r);
         if (res != VEIL_OK) return res;
-        res = veil_ev_build_density(r->ev, p->given_grid, p->given_density, (int)p->scene->light_count,
+        res = veil_ev_build_density(r->ev, p->given_grid, p->given_density, (int)veil_scene_light_total(p->scene),
                                     p->budget, err);
         if (res == VEIL_OK) r->has[VEIL_STAGE_INJECT] = 1, r->kept[VEIL_STAGE_INJECT] = rep->key;
         return res;
@@ -173,7 +173,7 @@ static veil_result inject_build(veil_frame* f, veil_stage_report* rep, veil_erro
         return res;
     }
     veil_ev_report er = {0};
-    if (res == VEIL_OK) res = veil_ev_build_scene(r->ev, &v, (int)p->scene->light_count, p->budget, &er, err);
+    if (res == VEIL_OK) res = veil_ev_build_scene(r->ev, &v, (int)veil_scene_light_total(p->scene), p->budget, &er, err);
     if (res == VEIL_OK) {
         r->has[VEIL_STAGE_INJECT] = 1, r->kept[VEIL_STAGE_INJECT] = rep->key;
         r->particles = er.particles;

@@ -127,6 +127,8 @@ static void set3(float dst[4], const float src[3], float w)
     dst[0] = src[0], dst[1] = src[1], dst[2] = src[2], dst[3] = w;
 }
 
+static int sees_environment(const veil_scene* s) { return s->environment.present && !s->background_set; }
+
 veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u, veil_error* err)
 {
     veil_camera_basis cam;
@@ -138,7 +140,9 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
     set3(u->cam_fwd, cam.center, 0.0f);
     set3(u->cam_right, cam.right, cam.clip[0]);
     set3(u->cam_up, cam.up, isfinite(cam.clip[1]) ? cam.clip[1] : FLT_MAX);
-    if (!d->no_background) set3(u->background, lm->scene->background, 0.0f);
+    /* an environment is seen behind the medium (added after the march, environment_behind), unless the scene
+     * gives a background of its own */
+    if (!d->no_background && !sees_environment(lm->scene)) set3(u->background, lm->scene->background, 0.0f);
     u->march[0] = lm->grid ? d->step_voxels * lm->grid->voxel : VEIL_FOG_MIN_STEP;
     u->limits[0] = d->max_distance > 0.0f ? d->max_distance : 3.0e38f;
     int fogs = 0;
@@ -238,6 +242,27 @@ static veil_result planar_depth(const veil_march_desc* d, veil_image_set* out, v
             size_t i = (size_t)py * (size_t)d->width + (size_t)px;
             float dist = out->aov_s[4 * i + 3];
             out->aov_z[i] = dist > 0.0f ? (float)(dist * c) : INFINITY;
+        }
+    return VEIL_OK;
+}
+
+/* The environment seen through the medium: T times its radiance along each pixel's ray (the march added no
+ * background). On the CPU, after the read-back: the map is piecewise constant and looked up once a pixel. */
+static veil_result environment_behind(const veil_march_desc* d, veil_image_set* out, veil_error* err)
+{
+    veil_camera_basis b;
+    veil_result r = veil_camera_make_basis(d->camera, d->width, d->height, &b, err);
+    if (r != VEIL_OK) return r;
+    const veil_environment* env = &d->medium.scene->environment;
+    for (int py = 0; py < d->height; ++py)
+        for (int px = 0; px < d->width; ++px) {
+            float dir[3];
+            veil_camera_ray(&b, d->width, d->height, px, py, dir);
+            double n = sqrt((double)dir[0] * dir[0] + (double)dir[1] * dir[1] + (double)dir[2] * dir[2]), e[3];
+            double dd[3] = {dir[0] / n, dir[1] / n, dir[2] / n};
+            veil_env_radiance(env, dd, e);
+            size_t i = (size_t)py * (size_t)d->width + (size_t)px;
+            for (int k = 0; k < 3; ++k) out->rgba[4 * i + k] += (float)(out->aov_t[4 * i + k] * e[k]);
         }
     return VEIL_OK;
 }
@@ -346,6 +371,7 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         for (int i = 0; i < N && r == VEIL_OK; ++i)
             r = veil_gl_read_texture(tex[i], GL_RGBA, floats, *dst[i], "reading back the image", err);
         if (r == VEIL_OK) r = planar_depth(d, out, err);
+        if (r == VEIL_OK && !d->no_background && sees_environment(lm->scene)) r = environment_behind(d, out, err);
     }
     glDeleteTextures(N, tex);
     glDeleteTextures(1, &limit);
