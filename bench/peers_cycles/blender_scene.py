@@ -3,7 +3,8 @@
     blender -b --factory-startup --python bench/peers_cycles/blender_scene.py -- SCENE.json SPP SEED OUT.exr [sky]
 
 With `sky` the world is the scene's background colour (strength 1: radiance W m^-2 sr^-1, constant in
-every direction) and lights the medium, as `veil reference --background lights` has it; otherwise black.
+every direction) and lights the medium, as `veil reference --background lights` has it; a scene's light
+of type "environment" becomes the world (world_environment); otherwise black.
 
 The lights, camera, black world and unbiased settings are bench/fog_truth/blender_setup.py's (its
 calibrations: Power = 4 pi I, Strength = E, vertical sensor fit, 0.01 px filter). The medium: the vdb
@@ -28,10 +29,42 @@ def attr_grid(src):
     return src.get("grid", "density")
 
 
+def s_lights(scene_path):
+    with open(scene_path) as f:
+        return json.load(f).get("lights", [])
+
+
+def world_environment(sc, env, base):
+    """veil's environment light as the world: a constant colour, or its lat-long map as an Environment
+    Texture read with Closest interpolation (veil's map is piecewise constant, scene/environment.h, whose
+    axes are Blender's equirectangular ones once veil's are turned into Blender's), strength = intensity;
+    radiance W m^-2 sr^-1 in both."""
+    assert not env.get("rotation_deg"), "rotation: not mapped here"
+    nt = sc.world.node_tree
+    bg = nt.nodes["Background"]
+    k = env.get("intensity", 1.0)
+    tint = env.get("color", [1.0, 1.0, 1.0])
+    bg.inputs["Strength"].default_value = k
+    if "file" not in env:
+        bg.inputs["Color"].default_value = tuple(tint) + (1.0,)
+        return
+    assert tint == [1.0, 1.0, 1.0], "a tinted map: not mapped here"
+    tex = nt.nodes.new("ShaderNodeTexEnvironment")
+    path = env["file"] if os.path.isabs(env["file"]) else os.path.join(base, env["file"])
+    tex.image = bpy.data.images.load(path)
+    tex.image.colorspace_settings.name = "Non-Color"  # linear radiance as it is
+    tex.interpolation = "Closest"
+    tex.projection = "EQUIRECTANGULAR"
+    nt.links.new(tex.outputs["Color"], bg.inputs["Color"])
+    sc.world.cycles.sampling_method = "MANUAL"
+    sc.world.cycles.sample_map_resolution = max(tex.image.size[0], 64)
+
+
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:]
     scene_path, spp, seed, out = argv[:4]
     sky = len(argv) > 4 and argv[4] == "sky"
+    env = [x for x in s_lights(scene_path) if x["type"] == "environment"]
     with open(scene_path) as f:
         s = json.load(f)
     med = s["medium"]
@@ -45,7 +78,9 @@ def main():
         bg = sc.world.node_tree.nodes["Background"]
         bg.inputs["Color"].default_value = tuple(s.get("background", {}).get("color", [0.0, 0.0, 0.0])) + (1.0,)
         bg.inputs["Strength"].default_value = 1.0
-    bs.add_lights(sc, s["lights"])
+    if env:
+        world_environment(sc, env[0], os.path.dirname(scene_path))
+    bs.add_lights(sc, [x for x in s["lights"] if x["type"] != "environment"])
     bs.add_camera(sc, s["camera"])
     path = src["file"] if os.path.isabs(src["file"]) else os.path.join(os.path.dirname(scene_path), src["file"])
     bpy.ops.object.volume_import(filepath=path, align="WORLD", location=(0.0, 0.0, 0.0))

@@ -156,32 +156,64 @@ def export_light(ob, matrix, warnings):
 # World
 
 
-def export_background(scene, warnings):
-    """The world's colour as veil's backdrop (seen through the medium, lighting nothing)."""
-    if scene.render.film_transparent:
-        return [0.0, 0.0, 0.0]  # transparent film: the medium alone, alpha = 1 - mean transmittance
-    w = scene.world
-    if w is None:
-        return [0.0, 0.0, 0.0]
-    if not w.use_nodes or w.node_tree is None:
-        return _colour(w.color, 1.0)
-    nt = w.node_tree
+def _world_surface(w):
+    """The node feeding the world's active output's Surface, or None."""
     out = None
-    for n in nt.nodes:
+    for n in w.node_tree.nodes:
         if n.bl_idname == 'ShaderNodeOutputWorld' and (out is None or n.is_active_output):
             out = n
     if out is None or not out.inputs['Surface'].is_linked:
-        return [0.0, 0.0, 0.0]  # no output: Blender's world is black too
-    src = out.inputs['Surface'].links[0].from_node
+        return None
+    return out.inputs['Surface'].links[0].from_node
+
+
+def export_world(scene, warnings):
+    """The world as veil's environment light (it lights the medium, as Cycles' world does, and is seen
+    behind it): {"type": "environment", "up": "z", ...} with a Background node's colour x strength, or
+    its Environment Texture's image (an OpenEXR file, equirectangular, no mapping: veil's map in
+    Blender's axes, docs/scene-format.md) times the strength; None for a black world. A transparent
+    film still lights the medium but shows nothing behind it: the caller writes a black background."""
+    w = scene.world
+    if w is None:
+        return None
+    if not w.use_nodes or w.node_tree is None:
+        col = _colour(w.color, 1.0)
+        return {'type': 'environment', 'color': col, 'up': 'z'} if any(c > 0.0 for c in col) else None
+    src = _world_surface(w)
+    if src is None:
+        return None  # no output: Blender's world is black too
     if src.bl_idname != 'ShaderNodeBackground':
-        warnings.append("world '%s': its surface is a %s node; veil reads a Background node's colour x strength "
-                        "only: background black" % (w.name, src.bl_idname))
-        return [0.0, 0.0, 0.0]
+        warnings.append("world '%s': its surface is a %s node; veil reads a Background node (a colour or an "
+                        "Environment Texture, times its strength) only: no environment" % (w.name, src.bl_idname))
+        return None
     col, strength = src.inputs['Color'], src.inputs['Strength']
-    if col.is_linked or strength.is_linked:
-        warnings.append("world '%s': the Background node's inputs are linked (textures, sky): veil uses their "
-                        "unlinked values" % w.name)
-    return _colour(col.default_value[:3], strength.default_value)
+    if strength.is_linked:
+        warnings.append("world '%s': the Background node's Strength is linked: veil uses its unlinked value" % w.name)
+    k = max(float(strength.default_value), 0.0)
+    if not col.is_linked:
+        c = _colour(col.default_value[:3], k)
+        return {'type': 'environment', 'color': c, 'up': 'z'} if any(v > 0.0 for v in c) else None
+    tex = col.links[0].from_node
+    if tex.bl_idname != 'ShaderNodeTexEnvironment' or tex.image is None:
+        warnings.append("world '%s': the Background's Color comes from a %s node; veil reads an Environment "
+                        "Texture with an image: no environment" % (w.name, tex.bl_idname))
+        return None
+    path = bpy.path.abspath(tex.image.filepath, library=tex.image.library)
+    if tex.image.packed_file is not None or not path.lower().endswith('.exr') or not os.path.isfile(path):
+        warnings.append("world '%s': image '%s' is not an OpenEXR file on disk (%s); veil reads lat-long EXR maps: "
+                        "no environment" % (w.name, tex.image.name, path or "packed"))
+        return None
+    if tex.projection != 'EQUIRECTANGULAR':
+        warnings.append("world '%s': the Environment Texture's projection is %s; veil reads equirectangular "
+                        "maps: no environment" % (w.name, tex.projection.lower()))
+        return None
+    if tex.inputs['Vector'].is_linked:
+        warnings.append("world '%s': the Environment Texture's Vector is linked (a mapping): veil reads the map "
+                        "in Blender's axes, unrotated" % w.name)
+    if tex.interpolation != 'Closest':
+        warnings.append("world '%s': veil reads the map's texels as constant cells (Blender's Closest "
+                        "interpolation), not %s" % (w.name, tex.interpolation))
+    return {'type': 'environment', 'file': path, 'intensity': k, 'up': 'z'}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -341,12 +373,17 @@ def export_scene(depsgraph, *, sequences_as_pattern=False, size=None, render_vis
             skipped.add(ob.type.lower())
     if skipped:
         warnings.append("not exported (veil renders Volume objects and lights): %s objects" % ', '.join(sorted(skipped)))
+    env = export_world(scene, warnings)
+    if env is not None:
+        lights.append(env)
     if len(lights) > MAX_LIGHTS:
-        raise ExportError("%d lights: veil renders at most %d" % (len(lights), MAX_LIGHTS))
+        raise ExportError("%d lights%s: veil renders at most %d" % (len(lights), " (the world's included)"
+                                                                      if env is not None else "", MAX_LIGHTS))
     medium['sources'] = sources
     out['medium'] = medium
     out['lights'] = lights
-    out['background'] = {'color': export_background(scene, warnings)}
+    if env is None or scene.render.film_transparent:
+        out['background'] = {'color': [0.0, 0.0, 0.0]}  # transparent film: the medium alone, alpha 1 - mean T
     out['quality'] = settings.quality.lower()
     if not settings.multiple_scattering:
         out['multiple_scattering'] = {'volumetric': False, 'screen_space': False}

@@ -69,7 +69,7 @@ class VIEWLAYER_PT_veil_passes(VeilPanel, bpy.types.Panel):
 
 
 class WORLD_PT_veil_background(VeilPanel, bpy.types.Panel):
-    bl_label = "veil Background"
+    bl_label = "veil World"
     bl_context = "world"
 
     @classmethod
@@ -80,18 +80,23 @@ class WORLD_PT_veil_background(VeilPanel, bpy.types.Panel):
         layout = self.layout
         layout.use_property_split = True
         w = context.world
-        if context.scene.render.film_transparent:
-            layout.label(text="Film is transparent: no background", icon='INFO')
         if w.use_nodes and w.node_tree is not None:
             bg = next((n for n in w.node_tree.nodes if n.bl_idname == 'ShaderNodeBackground'), None)
             if bg is None:
                 layout.label(text="No Background node: black", icon='INFO')
             else:
-                layout.prop(bg.inputs['Color'], "default_value", text="Color")
+                if bg.inputs['Color'].is_linked:
+                    layout.label(text="Color: an Environment Texture (an OpenEXR file, Closest)", icon='IMAGE_DATA')
+                else:
+                    layout.prop(bg.inputs['Color'], "default_value", text="Color")
                 layout.prop(bg.inputs['Strength'], "default_value", text="Strength")
         else:
             layout.prop(w, "color")
-        layout.label(text="Seen through the medium; lights nothing")
+        layout.label(text="Lights the medium (veil's environment light)")
+        if context.scene.render.film_transparent:
+            layout.label(text="Film is transparent: not seen behind the medium", icon='INFO')
+        else:
+            layout.label(text="Seen behind the medium")
 
 
 class DATA_PT_veil_volume(VeilPanel, bpy.types.Panel):
