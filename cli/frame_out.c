@@ -23,10 +23,10 @@ veil_result veil_cli_write_frame(const veil_image_set* im, const char* exr, cons
 void veil_cli_print_deep(const veil_deep_report* d)
 {
     printf("deep       %9.2f ms  (%zu raw samples, at most %d a pixel, merged to %zu, at most %d a pixel; holdout "
-           "error of the merge at the raw samples' depths: alpha max %.3g, mean %.3g, colour max %.3g of the pixel's; "
-           "flat light spread over the samples: at most %.3g)\n",
+           "error of the merge at the raw samples' depths: alpha max %.3g, mean %.3g; colour (of the pixel's) max %.3g, "
+           "mean %.3g; flat light spread over the samples: at most %.3g)\n",
            d->ms, d->raw, d->max_raw, d->kept, d->cap, d->holdout_alpha_max, d->holdout_alpha_mean,
-           d->holdout_color_max, d->residual_max);
+           d->holdout_color_max, d->holdout_color_mean, d->residual_max);
 }
 
 void veil_cli_print_stages(const veil_render_stats* st)

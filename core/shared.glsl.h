@@ -99,9 +99,10 @@
  * ends where its opacity crosses a multiple of 1/R of the pixel's (equal-
  * opacity buckets), where the ray leaves the medium into empty space, and at
  * the ray's end; none opens once the mean transmittance is below
- * VEIL_DEEP_MIN_T (a sample's colour is divided by the transmittance at its
- * front: 1e-20 keeps that quotient within float range for any radiance the
- * scene bounds allow, and what lies behind is below 1e-20 of the light). */
+ * VEIL_DEEP_MIN_T: a sample's colour is what it adds divided by the
+ * transmittance at its front, both tiny there (a float T underflows to
+ * denormals near 1e-38 and to 0 below; 0/0 would be NaN), and what lies
+ * behind 1e-20 is below 1e-20 of the light, so the open sample takes it. */
 #define VEIL_BIND_DEEP_COUNT 5   /* SSBO: uint[band rows * width] */
 #define VEIL_BIND_DEEP_SAMPLES 6 /* SSBO: float[band rows * width * R * 6] */
 #define VEIL_DEEP_MIN_T 1e-20

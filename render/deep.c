@@ -140,7 +140,8 @@ static double luminance(const double c[4]) { return VEIL_LUM_R * c[0] + VEIL_LUM
 
 /* The holdout error of m merged samples against n raw ones at each raw sample's Z and ZBack, in one
  * sweep (both front to back; the merged boundaries are raw ones). */
-static void measure_pixel(const float* raw, uint32_t n, const float* mer, uint32_t m, veil_deep_report* rep)
+static void measure_pixel(const float* raw, uint32_t n, const float* mer, uint32_t m, veil_deep_report* rep,
+                          size_t* lit)
 {
     double total[4];
     veil_deep_flatten(raw, n, total);
@@ -172,7 +173,12 @@ static void measure_pixel(const float* raw, uint32_t n, const float* mer, uint32
             const double ea = fabs(q[3] - pr[3]);
             rep->holdout_alpha_max = fmax(rep->holdout_alpha_max, ea);
             rep->holdout_alpha_mean += ea;
-            if (y > 0.0) rep->holdout_color_max = fmax(rep->holdout_color_max, fabs(luminance(q) - luminance(pr)) / y);
+            if (y > 0.0) {
+                const double ec = fabs(luminance(q) - luminance(pr)) / y;
+                rep->holdout_color_max = fmax(rep->holdout_color_max, ec);
+                rep->holdout_color_mean += ec;
+                ++*lit;
+            }
             ++rep->holdout_points;
         }
 }
@@ -208,6 +214,7 @@ veil_result veil_deep_finish(veil_deep_image* d, const float* rgba, const float*
     float raw[VEIL_DEEP_MAX_RAW * F], mer[VEIL_DEEP_MAX_RAW * F];
     const float* src = d->samples;
     float* dst = out;
+    size_t lit = 0; /* holdout points of pixels with light (the colour error's mean) */
     for (size_t i = 0; i < pixels; ++i) {
         uint32_t n = d->counts[i];
         memcpy(raw, src, (size_t)n * F * sizeof *raw);
@@ -225,7 +232,7 @@ veil_result veil_deep_finish(veil_deep_image* d, const float* rgba, const float*
         memcpy(mer, raw, (size_t)n * F * sizeof *mer);
         uint32_t m = merge_pixel(mer, n, cap);
         if (m < n) fix_pixel(mer, m, target); /* the merges' rounding */
-        measure_pixel(raw, n, mer, m, rep);
+        measure_pixel(raw, n, mer, m, rep, &lit);
         memcpy(dst, mer, (size_t)m * F * sizeof *dst);
         dst += (size_t)m * F;
         d->counts[i] = m;
@@ -235,6 +242,7 @@ veil_result veil_deep_finish(veil_deep_image* d, const float* rgba, const float*
     d->total = (size_t)(dst - out) / F;
     rep->kept = d->total;
     if (rep->holdout_points) rep->holdout_alpha_mean /= (double)rep->holdout_points;
+    if (lit) rep->holdout_color_mean /= (double)lit;
     rep->ms = veil_now_ms() - t0;
     return VEIL_OK;
 }

@@ -63,9 +63,9 @@ typedef struct veil_deep_report {
     int max_raw, cap;          /* the most raw samples of a pixel; the cap */
     double residual_max;       /* the largest |flat - flatten(raw)| spread over a pixel's samples (rgb) */
     /* the holdout error of the merged samples against the raw ones, at the raw samples' depths (their Z and
-     * ZBack) in every pixel with samples: alpha in front of that depth, max and mean; colour, the largest
-     * |error| in luminance over the pixel's flattened luminance */
-    double holdout_alpha_max, holdout_alpha_mean, holdout_color_max;
+     * ZBack) in every pixel with samples: alpha in front of that depth, max and mean; colour, |error| in
+     * luminance over the pixel's flattened luminance, max and mean (over the points of pixels that have light) */
+    double holdout_alpha_max, holdout_alpha_mean, holdout_color_max, holdout_color_mean;
     size_t holdout_points;
     double ms;                 /* the time it took */
 } veil_deep_report;
