@@ -27,6 +27,7 @@
  *      optical depth. Bound: T (8 (N + 4) 2^-23 + 6 2^-24 k t1) + (n + 1) 2^-23.
  *    - the merge's holdout error (the report) is 0 up to that rounding for
  *      the slab (homogeneous: nothing is lost), and all samples flatten.
+ *    - the flat image is the one rendered without deep samples, bit for bit.
  * 2. veil_deep_finish on a hand-made pixel of two wisps with a gap: merged
  *    to one sample, the holdout at the gap reads the merged sample's
  *    split, and the report gives that error exactly (the anti-vacuity case:
@@ -66,6 +67,13 @@ static void slab(veil_renderer* r, int cap)
     veil_error err = {0};
     veil_render_opts o = {.seed = 5, .deep = 1, .deep_samples = cap};
     CHECK(veil_render_scene_images(r, &s, &o, &im, &st, &err) == VEIL_OK, "cap %d: %s", cap, err.msg);
+    /* the flat image is the march's without deep samples, bit for bit (the same arithmetic, other bands) */
+    veil_image_set plain = {0};
+    o.deep = 0;
+    CHECK(veil_render_scene_images(r, &s, &o, &plain, NULL, &err) == VEIL_OK, "cap %d: %s", cap, err.msg);
+    CHECK(plain.rgba && im.rgba && memcmp(plain.rgba, im.rgba, sizeof(float) * 4 * W * H) == 0 && !plain.deep.counts,
+          "cap %d: the flat image differs with deep samples", cap);
+    veil_image_set_free(&plain);
     const veil_deep_image* d = &im.deep;
     CHECK(d->counts && d->width == W && d->height == H, "cap %d: no deep image", cap);
     if (!d->counts) return;
