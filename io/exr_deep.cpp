@@ -121,7 +121,6 @@ void write_file(int fd, const char* path, const veil_deep_image* d, const veil_e
         first[i] = d->samples + at * VEIL_DEEP_CHANNELS;
         at += d->counts[i];
     }
-    std::vector<const float*> ptr(pixels);
     fd_ostream os(fd, path);
     Imf::DeepScanLineOutputFile file(os, header);
     Imf::DeepFrameBuffer fb;
