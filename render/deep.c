@@ -85,17 +85,22 @@ void veil_deep_holdout(const float* s, uint32_t n, double d, double out[4])
     }
 }
 
-/* Makes a pixel's samples flatten to `target` (rgb, alpha): the last sample's alpha so that the flattened
- * alpha is target[3], then the colour left over, added to each sample in proportion to its share of the
+/* Makes a pixel's samples flatten to `target` (rgb, alpha): the alpha of its most opaque sample so that the
+ * flattened alpha is target[3] (the march's alphas are each rounded by up to 2^-24 absolutely, which a thin
+ * sample cannot take up: one of alpha 0 would have to go negative), then the colour left over, added to each sample in proportion to its share of the
  * pixel's opacity (A_k / alpha: sum_k T_k A_k / alpha = 1 with T_k the transmittance in front of sample
  * k; equal shares when every sample is transparent). Returns the largest |colour left over|. */
 static double fix_pixel(float* s, uint32_t n, const double target[4])
 {
-    double P = 1.0;
-    for (uint32_t k = 0; k + 1 < n; ++k) P *= 1.0 - s[(size_t)k * F + VEIL_DEEP_A];
+    uint32_t j = 0;
+    for (uint32_t k = 1; k < n; ++k)
+        if (s[(size_t)k * F + VEIL_DEEP_A] > s[(size_t)j * F + VEIL_DEEP_A]) j = k;
+    double P = 1.0; /* the transmittance of the others */
+    for (uint32_t k = 0; k < n; ++k)
+        if (k != j) P *= 1.0 - s[(size_t)k * F + VEIL_DEEP_A];
     if (n && P > 0.0) {
         double a = 1.0 - (1.0 - target[3]) / P;
-        s[(size_t)(n - 1) * F + VEIL_DEEP_A] = (float)(a < 0.0 ? 0.0 : a > 1.0 ? 1.0 : a);
+        s[(size_t)j * F + VEIL_DEEP_A] = (float)(a < 0.0 ? 0.0 : a > 1.0 ? 1.0 : a);
     }
     double f[4], worst = 0.0;
     veil_deep_flatten(s, n, f);

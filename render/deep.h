@@ -18,8 +18,8 @@
  *    space spread, the clamp of a negative cache estimate, rounding) is
  *    added to a pixel's samples in proportion to each one's share of the
  *    pixel's opacity (to a transparent sample over the frame's medium depth
- *    where a pixel has none), and the last sample's alpha is set so that
- *    the flattened alpha is the flat one;
+ *    where a pixel has none), and the most opaque sample's alpha is set so
+ *    that the flattened alpha is the flat one;
  *  - merges adjacent samples, the pair holding the least of the pixel's
  *    opacity first, down to the cap. A merge is exact for the flatten
  *    (C = C1 + (1 - A1) C2, A = 1 - (1 - A1)(1 - A2), Z = Z1, ZBack = ZBack2)

@@ -7,7 +7,10 @@
 # unwritable deep path refused; a deep file that cannot be written (a file
 # size limit) leaves the existing deep and flat files as they were.
 #
-#   deep_cli.sh VEIL SCENE CHECK.py
+#   deep_cli.sh VEIL SCENE CHECK.py [SCENE2]
+#
+# SCENE2 (a bright, thin cloud) is checked too: thin stretches whose alpha
+# rounds to 0 in float, where the flat alpha has to be met by another sample.
 #
 # Prints PASS or FAIL lines; exits 0 when all pass, 77 (skipped) without a GL
 # 4.5 context (a failure under CI=true).
@@ -15,6 +18,7 @@ set -u
 veil=$1
 scene=$2
 checker=$3
+scene2=${4:-}
 work=$(mktemp -d) || { echo "FAIL: mktemp"; exit 1; }
 trap 'rm -rf -- "$work"' EXIT
 fails=0
@@ -66,6 +70,15 @@ grep -q "^spread .*(ran" "$work/out" || { echo "FAIL: the spread did not run: th
 check "deep file, spread" 0 "flatten error at most" \
     /usr/bin/python3 "$checker" "$work/deep3.exr" "$work/flat3.exr" 8 "$bg"
 cat "$work/out"
+
+if [ -n "$scene2" ]; then
+    bg2=$(/usr/bin/python3 -c 'import json,sys; print(",".join(str(c) for c in json.load(open(sys.argv[1])).get("background", {}).get("color", [0, 0, 0])))' "$scene2")
+    check "render --deep, $(basename "$scene2")" 0 "deep " "$veil" render "$scene2" -o "$work/flat4.exr" --aovs \
+        --deep "$work/deep4.exr" --stats --width 64 --height 48 # (pixel 5,34 has such a stretch last)
+    check "deep file, $(basename "$scene2")" 0 "flatten error at most" \
+        /usr/bin/python3 "$checker" "$work/deep4.exr" "$work/flat4.exr" 8 "$bg2"
+    cat "$work/out"
+fi
 
 # a turntable: each frame its deep file, named as its EXR is
 check "turntable --deep" 0 "2 frames rendered" "$veil" turntable "$scene" -o "$work/tt/f.####.exr" \

@@ -8,7 +8,7 @@
  *    - flatten(samples) = rgb - T background and the flat alpha. The
  *      samples are made (veil_deep_finish) so that their flatten in exact
  *      arithmetic is the target computed in double; what remains is storing
- *      each finished colour and the last alpha as float, at most 2^-24 of
+ *      each finished colour and one alpha as float, at most 2^-24 of
  *      each, so |flatten - target| <= 2^-24 sum_k T_k |C_k| for colour
  *      (T_k: the transmittance in front of sample k), 2^-24 for alpha, plus
  *      the double arithmetic (n 2^-52 of the same sum);
@@ -21,7 +21,7 @@
  *      transmittance at a step boundary is within 8 (N + 4) 2^-23 of its
  *      closed form relatively (test_image_set's bound, N steps); each
  *      sample's 1 - A = Tm(back) / Tm(front) is rounded twice (the quotient
- *      and 1 - A), 2^-23 absolutely, n + 1 of them (the last one's alpha set
+ *      and 1 - A), 2^-23 absolutely, n + 1 of them (the most opaque one's alpha set
  *      by the finish); the planar depths are t x cos rounded, the cosine from
  *      a normalised float direction: 6 2^-24 t1 of position, k times that in
  *      optical depth. Bound: T (8 (N + 4) 2^-23 + 6 2^-24 k t1) + (n + 1) 2^-23.
