@@ -207,7 +207,7 @@ int veil_cmd_fog(int argc, char** argv)
         veil_cli_progress_end();
         if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
     }
-    if (r == VEIL_OK) r = veil_cli_write_frame(&im, a.exr, a.png, a.aovs, NULL, &err); /* all or nothing */
+    if (r == VEIL_OK) r = veil_cli_write_frame(&im, a.exr, a.png, NULL, a.aovs, NULL, &err); /* all or nothing */
     if (r == VEIL_OK && a.stats) veil_cli_print_stages(&st);
     if (r == VEIL_OK) printf("wrote %s%s%s (depth from channel %s, as %s)\n", a.exr, a.png ? " and " : "",
                              a.png ? a.png : "", channel, a.depth_is_distance ? "distance along the ray" : "Z");

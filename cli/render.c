@@ -19,8 +19,8 @@
 #include "scene/camera.h"
 
 typedef struct render_args {
-    const char *scene, *exr, *png;
-    long width, height, seed, frames;
+    const char *scene, *exr, *png, *deep;
+    long width, height, seed, frames, deep_samples;
     float step, sun_across, sun_along;
     veil_opv_method method;
     veil_quality quality;
@@ -38,11 +38,16 @@ static int parse_render_args(int argc, char** argv, render_args* a)
         if (!strcmp(s, "--aovs")) { a->aovs = 1; continue; }
         int takes = !strcmp(s, "-o") || !strcmp(s, "--png") || !strcmp(s, "--width") || !strcmp(s, "--height") ||
                     !strcmp(s, "--step") || !strcmp(s, "--seed") || !strcmp(s, "--method") ||
-                    !strcmp(s, "--turntable") || !strcmp(s, "--quality") || !strcmp(s, "--od-spacing");
+                    !strcmp(s, "--turntable") || !strcmp(s, "--quality") || !strcmp(s, "--od-spacing") ||
+                    !strcmp(s, "--deep") || !strcmp(s, "--deep-samples");
         if (takes && !v) return veil_cli_usage_error("%s needs a value", s);
         if (!strcmp(s, "-o")) a->exr = v;
         else if (!strcmp(s, "--png")) a->png = v;
-        else if (!strcmp(s, "--width")) {
+        else if (!strcmp(s, "--deep")) a->deep = v;
+        else if (!strcmp(s, "--deep-samples")) {
+            if (!veil_cli_parse_int(v, 1, VEIL_DEEP_MAX_SAMPLES, &a->deep_samples))
+                return veil_cli_usage_error("--deep-samples: expected samples a pixel in 1..64, got '%s'", v);
+        } else if (!strcmp(s, "--width")) {
             if (!veil_cli_parse_int(v, 1, VEIL_SCENE_MAX_IMAGE, &a->width)) return veil_cli_usage_error("--width: expected an integer in 1..16384, got '%s'", v);
         } else if (!strcmp(s, "--height")) {
             if (!veil_cli_parse_int(v, 1, VEIL_SCENE_MAX_IMAGE, &a->height)) return veil_cli_usage_error("--height: expected an integer in 1..16384, got '%s'", v);
@@ -78,6 +83,7 @@ static int parse_render_args(int argc, char** argv, render_args* a)
     }
     if (!a->scene) return veil_cli_usage_error("%s", "render: missing SCENE.json");
     if (!a->exr && !a->explain) return veil_cli_usage_error("%s", "render: missing -o OUT.exr");
+    if (a->deep_samples && !a->deep) return veil_cli_usage_error("%s", "--deep-samples: needs --deep OUT.exr");
     return -1;
 }
 
@@ -115,7 +121,7 @@ int veil_cmd_render(int argc, char** argv)
      * PNG of --turntable N (OUT_0000.exr ...) and their staging names (issue 22: s_0001.json was
      * overwritten); then their folders, made */
     int n = 0;
-    veil_run_file* files = veil_cli_scene_inputs(a.scene, &scene, 0, 2, &n);
+    veil_run_file* files = veil_cli_scene_inputs(a.scene, &scene, 0, 3, &n);
     if (!files) {
         veil_scene_free(&scene);
         return veil_cli_fail(veil_fail(&err, VEIL_ERR_OOM, "out of memory"), &err);
@@ -126,6 +132,8 @@ int veil_cmd_render(int argc, char** argv)
     files[n++] = (veil_run_file){.what = "-o", .path = a.exr, .naming = naming, .writes = 1, .staged = staged};
     if (a.png)
         files[n++] = (veil_run_file){.what = "--png", .path = a.png, .naming = naming, .writes = 1, .staged = staged};
+    if (a.deep)
+        files[n++] = (veil_run_file){.what = "--deep", .path = a.deep, .naming = naming, .writes = 1, .staged = staged};
     const veil_frame_range turntable = {0, a.frames - 1, 1};
     veil_cli_folders made = {0};
     rc = veil_cli_check_run(files, n, a.frames > 0 ? &turntable : NULL);
@@ -148,7 +156,8 @@ int veil_cmd_render(int argc, char** argv)
         veil_camera cam = veil_camera_of_frame(&scene.camera, f, frames);
         veil_render_opts opts = {.width = (int)a.width, .height = (int)a.height, .step_voxels = a.step,
                                  .seed = (uint32_t)a.seed, .method = a.method, .quality = a.quality,
-                                 .sun_across = a.sun_across, .sun_along = a.sun_along, .camera = &cam};
+                                 .sun_across = a.sun_across, .sun_along = a.sun_along, .camera = &cam,
+                                 .deep = a.deep != NULL, .deep_samples = (int)a.deep_samples};
         veil_render_stats st = {0};
         char label[64] = "";
         if (frames > 1) snprintf(label, sizeof label, "frame %ld/%ld", f + 1, frames);
@@ -156,15 +165,18 @@ int veil_cmd_render(int argc, char** argv)
         r = veil_render_scene_images(ren, &scene, &opts, &im, &st, &err);
         veil_cli_progress_end();
         if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
-        char exr[4096], png[4096];
+        char exr[4096], png[4096], deep[4096];
         if (r == VEIL_OK) r = veil_frame_path(a.exr, f, a.frames > 0, exr, sizeof exr, &err);
         if (r == VEIL_OK && a.png) r = veil_frame_path(a.png, f, a.frames > 0, png, sizeof png, &err);
+        if (r == VEIL_OK && a.deep) r = veil_frame_path(a.deep, f, a.frames > 0, deep, sizeof deep, &err);
         double t_write = veil_now_ms();
-        if (r == VEIL_OK) r = veil_cli_write_frame(&im, exr, a.png ? png : NULL, a.aovs, NULL, &err);
+        if (r == VEIL_OK)
+            r = veil_cli_write_frame(&im, exr, a.png ? png : NULL, a.deep ? deep : NULL, a.aovs, NULL, &err);
         if (r != VEIL_OK) break;
         if (a.stats) {
             if (frames > 1) printf("frame %ld\n", f);
             veil_cli_print_stages(&st);
+            if (a.deep) veil_cli_print_deep(&st.deep);
             printf("write      %9.2f ms\n", veil_now_ms() - t_write);
         }
         if (frames == 1 || f == frames - 1)

@@ -24,7 +24,8 @@
 #include "scene/camera.h"
 
 typedef struct tt_args {
-    const char *scene, *exr, *png, *movie, *sheet;
+    const char *scene, *exr, *png, *movie, *sheet, *deep;
+    long deep_samples;
     float fps;
     long width, height, seed, frames;
     veil_frame_range range;
@@ -67,6 +68,11 @@ static int parse_args(int argc, char** argv, tt_args* a)
         veil_error err = {0};
         if (!strcmp(s, "-o")) a->exr = v;
         else if (!strcmp(s, "--png")) a->png = v;
+        else if (!strcmp(s, "--deep")) a->deep = v;
+        else if (!strcmp(s, "--deep-samples")) {
+            if (!veil_cli_parse_int(v, 1, VEIL_DEEP_MAX_SAMPLES, &a->deep_samples))
+                return veil_cli_usage_error("--deep-samples: expected samples a pixel in 1..64, got '%s'", v);
+        }
         else if (!strcmp(s, "--movie")) a->movie = v;
         else if (!strcmp(s, "--contact-sheet")) a->sheet = v;
         else if (!strcmp(s, "--fps")) {
@@ -125,6 +131,9 @@ static int parse_args(int argc, char** argv, tt_args* a)
     }
     if (a->png && veil_frame_pattern_kind(a->png) != 1)
         return veil_cli_usage_error("--png: '%s' needs the frame number once, as #### or %%04d", a->png);
+    if (a->deep && veil_frame_pattern_kind(a->deep) != 1)
+        return veil_cli_usage_error("--deep: '%s' needs the frame number once, as #### or %%04d", a->deep);
+    if (a->deep_samples && !a->deep) return veil_cli_usage_error("%s", "--deep-samples: needs --deep OUT.####.exr");
     return -1;
 }
 
@@ -133,7 +142,7 @@ static veil_render_opts opts_of(const tt_args* a, long frame, const veil_camera*
     return (veil_render_opts){.width = (int)a->width, .height = (int)a->height, .step_voxels = a->step,
                               .seed = veil_frame_seed((uint32_t)a->seed, frame), .method = a->method,
                               .quality = a->quality, .sun_across = a->sun_across, .sun_along = a->sun_along,
-                              .camera = cam};
+                              .camera = cam, .deep = a->deep != NULL, .deep_samples = (int)a->deep_samples};
 }
 
 /* FNV-1a of the scene file's bytes (0 when it cannot be read: it was, a moment ago). */
@@ -182,7 +191,7 @@ static int prepare_files(const tt_args* a, const veil_scene* scene, long count, 
         return veil_cli_usage_error("%s", what);
     }
     int n = 0;
-    veil_run_file* files = veil_cli_scene_inputs(a->scene, scene, 1, 6, &n);
+    veil_run_file* files = veil_cli_scene_inputs(a->scene, scene, 1, 7, &n);
     veil_error err = {0};
     if (!files) return veil_cli_fail(veil_fail(&err, VEIL_ERR_OOM, "out of memory"), &err);
     char staged[48], movie_staged[4200], movie_frames[4200];
@@ -191,6 +200,9 @@ static int prepare_files(const tt_args* a, const veil_scene* scene, long count, 
                                  .staged = staged};
     if (a->png)
         files[n++] = (veil_run_file){.what = "--png", .path = a->png, .naming = VEIL_RUN_PATTERN, .writes = 1,
+                                     .staged = staged};
+    if (a->deep)
+        files[n++] = (veil_run_file){.what = "--deep", .path = a->deep, .naming = VEIL_RUN_PATTERN, .writes = 1,
                                      .staged = staged};
     if (a->sheet) files[n++] = (veil_run_file){.what = "--contact-sheet", .path = a->sheet, .writes = 1};
     if (a->movie) {
@@ -305,12 +317,14 @@ int veil_cmd_turntable(int argc, char** argv)
     int stage_runs[VEIL_STAGE_COUNT] = {0};
     for (long i = a.shard - 1; i < count && r == VEIL_OK; i += a.shards) {
         long frame = veil_frame_range_at(&a.range, i);
-        char exr[4096], png[4096];
+        char exr[4096], png[4096], deep[4096];
         r = veil_frame_pattern_path(a.exr, frame, exr, sizeof exr, &err);
         if (r == VEIL_OK && a.png) r = veil_frame_pattern_path(a.png, frame, png, sizeof png, &err);
+        if (r == VEIL_OK && a.deep) r = veil_frame_pattern_path(a.deep, frame, deep, sizeof deep, &err);
         if (r != VEIL_OK) break;
-        /* complete: frames are renamed into place, so an EXR and a PNG there are whole */
-        if (a.skip_existing && exists_as(exr, EXR_MAGIC, 4) && (!a.png || exists_as(png, PNG_MAGIC, 8))) {
+        /* complete: frames are renamed into place, so an EXR, a PNG and a deep EXR there are whole */
+        if (a.skip_existing && exists_as(exr, EXR_MAGIC, 4) && (!a.png || exists_as(png, PNG_MAGIC, 8)) &&
+            (!a.deep || exists_as(deep, EXR_MAGIC, 4))) {
             ++skipped;
             continue;
         }
@@ -363,7 +377,8 @@ int veil_cmd_turntable(int argc, char** argv)
         memcpy(meta.strings, strings, sizeof strings);
         meta.n_strings = 4;
         /* the frame's files all or nothing, renamed into place */
-        if (r == VEIL_OK) r = veil_cli_write_frame(&im, exr, a.png ? png : NULL, a.aovs, &meta, &err);
+        if (r == VEIL_OK)
+            r = veil_cli_write_frame(&im, exr, a.png ? png : NULL, a.deep ? deep : NULL, a.aovs, &meta, &err);
         if (r != VEIL_OK) break;
         ++done;
         for (int k = 0; k < VEIL_STAGE_COUNT; ++k) {
@@ -374,6 +389,7 @@ int veil_cmd_turntable(int argc, char** argv)
         if (a.stats) {
             printf("frame %ld\n", frame);
             veil_cli_print_stages(&st);
+            if (a.deep) veil_cli_print_deep(&st.deep);
             printf("write      %9.2f ms\n", veil_now_ms() - t_write);
         }
     }

@@ -92,6 +92,22 @@
  * background is still added with the transmittance reached). */
 #define VEIL_MIN_TRANSMITTANCE 1e-4
 
+/* Deep output (render/deep.h): the march compiled with VEIL_MARCH_DEEP
+ * (R, the raw samples a pixel) writes each pixel's stretches of the ray to
+ * two SSBOs, a band of rows at a time: the count a pixel (uint) and R
+ * samples of VEIL_DEEP_SAMPLE_FLOATS floats (R, G, B, A, Z, ZBack). A stretch
+ * ends where its opacity crosses a multiple of 1/R of the pixel's (equal-
+ * opacity buckets), where the ray leaves the medium into empty space, and at
+ * the ray's end; none opens once the mean transmittance is below
+ * VEIL_DEEP_MIN_T: a sample's colour is what it adds divided by the
+ * transmittance at its front, both tiny there (a float T underflows to
+ * denormals near 1e-38 and to 0 below; 0/0 would be NaN), and what lies
+ * behind 1e-20 is below 1e-20 of the light, so the open sample takes it. */
+#define VEIL_BIND_DEEP_COUNT 5   /* SSBO: uint[band rows * width] */
+#define VEIL_BIND_DEEP_SAMPLES 6 /* SSBO: float[band rows * width * R * 6] */
+#define VEIL_DEEP_MIN_T 1e-20
+#define VEIL_DEEP_SAMPLE_FLOATS 6 /* = VEIL_DEEP_CHANNELS (io/exr_deep.h) */
+
 /* Binding points. */
 #define VEIL_BIND_PARTICLES 0   /* SSBO: vec4 centre+amplitude, sharpness */
 #define VEIL_BIND_BRICK_START 1 /* SSBO: uint offsets per brick (+1) */

@@ -49,6 +49,7 @@ veil_render_opts veil_render_opts_resolve(const veil_render_opts* opts, const ve
     o.method = veil_opv_method_resolve(o.method);
     if (!(o.sun_across > 0.0f)) o.sun_across = q->sun_across;
     if (!(o.sun_along > 0.0f)) o.sun_along = q->sun_along;
+    if (o.deep_samples <= 0) o.deep_samples = s->deep_samples > 0 ? s->deep_samples : VEIL_DEEP_DEFAULT_SAMPLES;
     return o;
 }
 

@@ -95,6 +95,12 @@ static veil_result run_frame(veil_renderer* r, veil_frame* f, veil_render_stats*
     if (f->plan.scene->light_count > VEIL_MAX_LIGHTS)
         return veil_fail(err, VEIL_ERR_LIMIT, "%zu lights; at most %d are supported", f->plan.scene->light_count,
                          VEIL_MAX_LIGHTS);
+    if (o->deep && (o->deep_samples < 1 || o->deep_samples > VEIL_DEEP_MAX_SAMPLES))
+        return veil_fail(err, VEIL_ERR_INVALID, "deep samples: expected 1..%d samples a pixel, got %d",
+                         VEIL_DEEP_MAX_SAMPLES, o->deep_samples);
+    if (o->deep && o->behind) /* its samples would need the frame behind placed in depth */
+        return veil_fail(err, VEIL_ERR_INVALID, "a deep image of a frame rendered in front of another (veil fog) "
+                         "is not supported");
     f->parts = &r->parts;
     f->st = st;
     f->gpu = make_gpu;
@@ -123,6 +129,12 @@ static veil_result run_frame(veil_renderer* r, veil_frame* f, veil_render_stats*
     }
     veil_progress_set_stage(NULL);
     veil_frame_end(f);
+    /* the deep image: what the flat one added after the march spread over its samples, merged to the cap */
+    if (res == VEIL_OK && o->deep && f->images && f->images->deep.counts) {
+        const veil_image_set* im = f->images;
+        res = veil_deep_finish(&f->images->deep, im->rgba, im->aov_t, f->plan.scene->background, im->behind, o->deep_samples,
+                               &st->deep, err);
+    }
     st->inject_ms = st->stage[VEIL_STAGE_INJECT].ms;
     st->propagate_ms = st->stage[VEIL_STAGE_PROPAGATE].ms;
     st->render_ms = st->stage[VEIL_STAGE_RENDER].ms;

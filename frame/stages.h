@@ -30,6 +30,7 @@
 #include "../core/result.h"
 #include "../propagate/opv.h"
 #include "../propagate/opv_set.h"
+#include "../render/deep.h"
 #include "../render/image_set.h"
 #include "../scene/scene.h"
 #include "../scene/solid.h"
@@ -68,6 +69,10 @@ typedef struct veil_render_opts {
     /* 1: the surfaces at behind_distance neither shadow the medium nor absorb its light (by default they
      * do: scene/solid.h) */
     int behind_not_solid;
+    /* 1: a deep image too (the image set's deep, render/deep.h), of at most deep_samples samples a pixel
+     * (0: the scene's "deep": {"samples"}, else VEIL_DEEP_DEFAULT_SAMPLES) */
+    int deep;
+    int deep_samples;
 } veil_render_opts;
 
 /* opts (NULL: all defaults) with every zero replaced by what it means for
@@ -179,6 +184,7 @@ typedef struct veil_render_stats {
     int grids, grids_computed; /* light-space grids in use / made by this frame (propagate/sun_space.h) */
     veil_opv_method method;
     int propagate_iterations; /* Jacobi steps or sweep passes (most of any light) */
+    veil_deep_report deep;    /* the deep image's merge (render/deep.h), when one was made */
 } veil_render_stats;
 
 /* One frame in flight: the plan and, in a render, where the rows work. */

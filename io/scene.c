@@ -22,7 +22,10 @@
 #define SCENE_MAX_FILE_BYTES ((size_t)256 << 20) /* 256 MiB */
 
 static const char* const ROOT_KEYS[] = {"camera", "medium", "lights", "background", "multiple_scattering", "quality",
-                                        NULL};
+                                        "deep", NULL};
+static const char* const DEEP_KEYS[] = {"samples", NULL};
+static const range R_DEEP_SAMPLES = {1, VEIL_DEEP_MAX_SAMPLES, false, false, true, "an integer in [1, 64]"};
+_Static_assert(VEIL_DEEP_MAX_SAMPLES == 64, "R_DEEP_SAMPLES' text (and --deep-samples' in cli/) names the bound");
 static const char* const QUALITIES[] = {"draft", "default", "high", "max", NULL}; /* = veil_quality - 1 */
 static const char* const CAMERA_KEYS[] = {"position", "look_at", "up", "fov_y_deg", "fov_deg", "sensor_fit", "shift",
                                           "clip", "width", "height", NULL};
@@ -313,6 +316,17 @@ static veil_result parse_background(const ctx* c, const cJSON* root, float color
     return veil__jr_get_floats_in(c, o, &p, "color", false, 3, &VEIL__R_BACKGROUND, color);
 }
 
+/* "deep": {"samples": N}: a deep image's cap (render/deep.h); 0 when absent */
+static veil_result parse_deep(const ctx* c, const cJSON* root, int* samples)
+{
+    const jpath p = {NULL, "deep", 0};
+    const cJSON* o;
+    TRY(veil__jr_get_container(c, root, &p, false, false, &o));
+    if (!o) return VEIL_OK;
+    TRY(veil__jr_check_keys(c, o, &p, DEEP_KEYS));
+    return veil__jr_get_int(c, o, &p, "samples", &R_DEEP_SAMPLES, samples);
+}
+
 static veil_result parse_root(const ctx* c, const cJSON* root, veil_scene* s)
 {
     if (!cJSON_IsObject(root)) {
@@ -329,6 +343,7 @@ static veil_result parse_root(const ctx* c, const cJSON* root, veil_scene* s)
     TRY(veil__jr_get_name(c, root, NULL, "quality", QUALITIES, &q));
     s->quality = (veil_quality)(q + 1);
     s->background_set = cJSON_GetObjectItemCaseSensitive(root, "background") != NULL;
+    TRY(parse_deep(c, root, &s->deep_samples));
     return parse_background(c, root, s->background);
 }
 

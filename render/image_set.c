@@ -21,6 +21,8 @@ void veil_image_set_free(veil_image_set* s)
     free(s->aov_m);
     free(s->aov_q);
     free(s->aov_z);
+    free(s->behind);
+    veil_deep_image_free(&s->deep);
     memset(s, 0, sizeof *s);
 }
 

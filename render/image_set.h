@@ -22,12 +22,15 @@
  *   aov_q  (not written to files) the screen-space pass's source: single
  *          scattering's light scattered, not absorbed, on its way to the
  *          camera (R, G, B), and the luminance-weighted P of it
+ *   deep   (when the render asked for it) each pixel's ray as volumetric
+ *          samples that flatten to rgba less T * background (render/deep.h)
  * rgba = T * background + single + volumetric + screen-space.
  */
 #ifndef VEIL_IMAGE_SET_H
 #define VEIL_IMAGE_SET_H
 
 #include "../core/result.h"
+#include "../io/exr_deep.h"
 #include "../io/image.h"
 
 typedef struct veil_image_set {
@@ -39,6 +42,9 @@ typedef struct veil_image_set {
     float* aov_m;
     float* aov_q;
     float* aov_z;
+    float* behind; /* 3 floats a pixel: the radiance seen behind the medium when it varies by pixel (an
+                      environment light, render/march.c), else NULL (the scene's background) */
+    veil_deep_image deep; /* the deep image (render/deep.h) when asked for (counts NULL: none) */
 } veil_image_set;
 
 void veil_image_set_free(veil_image_set* s); /* accepts NULL and zeroed sets */

@@ -27,7 +27,7 @@ enum { MARCH_PROGRAMS = 12 };
 
 typedef struct {
     GLuint program;
-    char defines[VEIL_MAX_LIGHTS * 24 + 192];
+    char defines[VEIL_MAX_LIGHTS * 24 + 224];
 } march_program;
 
 struct veil_march {
@@ -59,7 +59,7 @@ static void append(char* dst, size_t cap, const char* fmt, int a, int b, int c)
 /* The march's program for this frame: the medium's block mu, the march's u, the lights compiled in
  * or not. */
 static veil_result program_for(veil_march* m, const veil_lit_medium* lm, const veil_medium_block* mu,
-                               const veil_march_block* u, int light_list, GLuint* out, veil_error* err)
+                               const veil_march_block* u, int light_list, int deep_raw, GLuint* out, veil_error* err)
 {
     march_program want;
     memset(&want, 0, sizeof want);
@@ -69,6 +69,8 @@ static veil_result program_for(veil_march* m, const veil_lit_medium* lm, const v
     if (lm->grid && lm->emission)
         append(want.defines, cap, "#define VEIL_MARCH_EMISSION 1\n", 0, 0, 0), strcat(name, "emission, ");
     if (mu->solid_origin[3] > 0.0f) append(want.defines, cap, "#define VEIL_SOLID 1\n", 0, 0, 0), strcat(name, "solid, ");
+    if (deep_raw > 0) /* the deep samples (render/deep.h): R a pixel */
+        append(want.defines, cap, "#define VEIL_MARCH_DEEP %d\n", deep_raw, 0, 0), strcat(name, "deep, ");
     if (light_list) { /* and the field with them (march.comp says why not apart) */
         const int field = (int)u->diffusion[3];
         append(want.defines, cap, "#define VEIL_MARCH_FIELD %d\n#define VEIL_MARCH_GATHER %d\n", field, u->march[1] > 0.0f, 0);
@@ -254,6 +256,8 @@ static veil_result environment_behind(const veil_march_desc* d, veil_image_set* 
     veil_result r = veil_camera_make_basis(d->camera, d->width, d->height, &b, err);
     if (r != VEIL_OK) return r;
     const veil_environment* env = &d->medium.scene->environment;
+    out->behind = malloc((size_t)d->width * (size_t)d->height * 3 * sizeof *out->behind);
+    if (!out->behind) return veil_fail(err, VEIL_ERR_OOM, "out of memory for a %dx%d environment plane", d->width, d->height);
     for (int py = 0; py < d->height; ++py)
         for (int px = 0; px < d->width; ++px) {
             float dir[3];
@@ -262,7 +266,10 @@ static veil_result environment_behind(const veil_march_desc* d, veil_image_set* 
             double dd[3] = {dir[0] / n, dir[1] / n, dir[2] / n};
             veil_env_radiance(env, dd, e);
             size_t i = (size_t)py * (size_t)d->width + (size_t)px;
-            for (int k = 0; k < 3; ++k) out->rgba[4 * i + k] += (float)(out->aov_t[4 * i + k] * e[k]);
+            for (int k = 0; k < 3; ++k) {
+                out->behind[3 * i + k] = (float)e[k];
+                out->rgba[4 * i + k] += out->aov_t[4 * i + k] * out->behind[3 * i + k];
+            }
         }
     return VEIL_OK;
 }
@@ -306,7 +313,29 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
     }
     GLuint program = 0;
     const int light_list = row_work(d, w) * h >= (double)g_light_list_work;
-    if (r == VEIL_OK) r = program_for(m, lm, &mu, &u, light_list, &program, err);
+    if (r == VEIL_OK) r = program_for(m, lm, &mu, &u, light_list, d->deep_raw, &program, err);
+    /* deep: a band's buffers (counts, R samples a pixel) within VEIL_DEEP_BAND_BYTES, read after each band */
+    int band = veil_march_band_rows(d, w, h);
+    GLuint deep_buf[2] = {0, 0};
+    uint32_t* deep_counts = NULL;
+    float* deep_samples = NULL;
+    size_t deep_row_floats = (size_t)w * (size_t)(d->deep_raw > 0 ? d->deep_raw : 0) * VEIL_DEEP_CHANNELS;
+    if (r == VEIL_OK && d->deep_raw > 0) {
+        const size_t row_bytes = (size_t)w * (sizeof(uint32_t) + (size_t)d->deep_raw * VEIL_DEEP_CHANNELS * sizeof(float));
+        size_t rows = VEIL_DEEP_BAND_BYTES / row_bytes / VEIL_MARCH_GROUP * VEIL_MARCH_GROUP;
+        if (rows < VEIL_MARCH_GROUP) rows = VEIL_MARCH_GROUP;
+        if ((size_t)band > rows) band = (int)rows;
+        out->deep.width = w, out->deep.height = h;
+        deep_counts = malloc((size_t)band * (size_t)w * sizeof *deep_counts);
+        deep_samples = malloc((size_t)band * deep_row_floats * sizeof *deep_samples);
+        if (!deep_counts || !deep_samples) r = veil_fail(err, VEIL_ERR_OOM, "out of memory for a band of deep samples");
+        if (r == VEIL_OK)
+            r = veil_gl_buffer(NULL, (size_t)band * (size_t)w * sizeof(uint32_t), GL_DYNAMIC_STORAGE_BIT,
+                               "veil deep counts", &deep_buf[0], err);
+        if (r == VEIL_OK)
+            r = veil_gl_buffer(NULL, (size_t)band * deep_row_floats * sizeof(float), GL_DYNAMIC_STORAGE_BIT,
+                               "veil deep samples", &deep_buf[1], err);
+    }
     if (r == VEIL_OK) {
         glUseProgram(program);
         veil_ev_sparse_bind(lm->grid ? lm->sparse : NULL);
@@ -340,7 +369,10 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
             }
         }
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], tex[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        const int band = veil_march_band_rows(d, w, h);
+        if (deep_buf[0]) {
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_DEEP_COUNT, deep_buf[0]);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_DEEP_SAMPLES, deep_buf[1]);
+        }
         const int report = veil_progress_wanted();
         if (report) veil_progress("march, rows", 0, h);
         for (int y = 0; y < h && r == VEIL_OK; y += band) { /* (r: the gather's program was made) */
@@ -348,7 +380,16 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
                 u.size[2] = y;
                 glNamedBufferSubData(m->ubo, offsetof(veil_march_block, size), sizeof u.size, u.size);
             }
-            glDispatchCompute(veil_groups(w, VEIL_MARCH_GROUP), veil_groups(h - y < band ? h - y : band, VEIL_MARCH_GROUP), 1);
+            const int rows = h - y < band ? h - y : band;
+            glDispatchCompute(veil_groups(w, VEIL_MARCH_GROUP), veil_groups(rows, VEIL_MARCH_GROUP), 1);
+            if (deep_buf[0]) { /* this band's samples, before the next band overwrites them */
+                glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+                glGetNamedBufferSubData(deep_buf[0], 0, (GLsizeiptr)((size_t)rows * w * sizeof(uint32_t)), deep_counts);
+                glGetNamedBufferSubData(deep_buf[1], 0, (GLsizeiptr)((size_t)rows * deep_row_floats * sizeof(float)),
+                                        deep_samples);
+                r = veil_gl_check("reading back the deep samples", err);
+                if (r == VEIL_OK) r = veil_deep_append_band(&out->deep, y, rows, d->deep_raw, deep_counts, deep_samples, err);
+            }
             if (report) { /* what is reported is done */
                 glFinish();
                 veil_progress("march, rows", y + band < h ? y + band : h, h);
@@ -361,6 +402,10 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         }
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
         for (int i = 0; i < N; ++i) glBindImageTexture(units[i], 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        if (deep_buf[0]) {
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_DEEP_COUNT, 0);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_DEEP_SAMPLES, 0);
+        }
         for (int t = 0; t <= VEIL_TEX_EMISSION; ++t) glBindTextureUnit((GLuint)t, 0);
         if (!(lm->grid && lm->sparse)) veil_lit_medium_bind_depths(NULL);
         veil_ev_sparse_bind(NULL);
@@ -375,6 +420,9 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
     }
     glDeleteTextures(N, tex);
     glDeleteTextures(1, &limit);
+    glDeleteBuffers(2, deep_buf);
+    free(deep_counts);
+    free(deep_samples);
     if (r != VEIL_OK) veil_image_set_free(out);
     return r;
 }

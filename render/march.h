@@ -20,6 +20,7 @@
 #include "../volume/ev.h"
 #include "../volume/volume.h"
 #include "../volumetric/volumetric.h"
+#include "deep.h"
 #include "image_set.h"
 
 /* Ray-march step as a fraction of the voxel edge. Half a voxel resolves the
@@ -72,6 +73,8 @@ typedef struct veil_march_desc {
     float gather_step;         /* the gather's steps along its rays, in the cache's cells (> 0) */
     int gather_cells;          /* the gather's cells along the cache grid's longest side, at most (each then
                                   longest / gather_cells of the cache's a side); 0: VEIL_GATHER_MAX_CELLS */
+    int deep_raw;              /* > 0: raw deep samples a pixel (render/deep.h), read into the image set's
+                                  deep image (the march compiled with VEIL_MARCH_DEEP); 0: none */
 } veil_march_desc;
 
 /* What the last veil_march_run gathered (render/shaders/cache_gather.comp): rays 0 when it did not. */

@@ -254,6 +254,13 @@ typedef struct veil_scene_grid {
     uint64_t hash;              /* of the values, dims, order and map: the stage caches' key */
 } veil_scene_grid;
 
+/* A deep image's cap, samples a pixel (render/deep.h): the default of
+ * "deep": {"samples"} and --deep-samples, and their bound (the merge costs
+ * O(raw^2) a pixel, raw = 4 x the cap, and a compositor slows with every
+ * sample a pixel). */
+#define VEIL_DEEP_DEFAULT_SAMPLES 8
+#define VEIL_DEEP_MAX_SAMPLES 64
+
 typedef struct veil_scene {
     char* path;     /* the file as given (owned) */
     char* base_dir; /* its folder, for relative paths (owned) */
@@ -266,6 +273,7 @@ typedef struct veil_scene {
     veil_environment environment; /* a light of type "environment" (at most one; not in `lights`) */
     veil_multiple multiple;
     veil_quality quality; /* "quality": UNSET when absent */
+    int deep_samples;     /* "deep": {"samples"}: a deep image's cap (render/deep.h); 0 when absent */
     veil_scene_grid* grids; /* owned; grid_count of them */
     size_t grid_count;
 } veil_scene;

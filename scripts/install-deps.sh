@@ -14,6 +14,7 @@ packages=(
   time                                                           # /usr/bin/time: tests bound a refusal's memory
   python3 python3-numpy python3-pytest python3-openvdb           # the Python module and its tests (docs/python.md)
   python3-setuptools python3-wheel python3-pip python3-venv      # pip install of python/ into a venv (tests/python)
+  python3-openimageio                                            # reads deep EXRs back as a compositor does (tests/cli/deep_cli.sh)
 )
 
 missing=()

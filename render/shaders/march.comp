@@ -50,6 +50,14 @@
 // the march ends at the first step boundary at or beyond it (the same steps);
 // with u.flags.w each pixel's ray ends exactly at the distance in u_limit (a
 // surface of a frame rendered elsewhere: `veil fog`).
+// Deep samples (VEIL_MARCH_DEEP = R, the raw samples a pixel; render/deep.h): the ray's stretches of
+// medium, each closed where its opacity crosses a multiple of 1/R of the pixel's, where the ray leaves
+// the medium into empty space (a step with no density nor emission, or a jump over an empty brick) and at
+// the end; the R-th keeps accumulating to the end (the flatten stays exact). A sample: its colour, what
+// the stretch adds to L + Lv divided by the mean transmittance Tm at its front; A = 1 - Tm(back) / Tm(front)
+// (the mean over channels: chromatic extinction is carried by the colour, not by A; the product of the
+// samples' 1 - A is Tm at the ray's end, so the flattened alpha is 1 - mean T); Z and ZBack the planar
+// depths (along the view axis, as the flat image's Z) of its first and last step with medium.
 // Compiled in for a large frame (render/march.c: the march's programs),
 // since llvmpipe runs both sides of every branch it cannot fold, texture
 // reads included: the lights (VEIL_LIGHT_LIST: each one's kind and
@@ -80,6 +88,61 @@ layout(binding = VEIL_TEX_LIMIT) uniform sampler2D u_limit; // u.flags.w: distan
 layout(binding = VEIL_TEX_DIFFUSION) uniform sampler3D u_phi; // u.diffusion.w: multiply scattered fluence (W/m^2)
 layout(binding = VEIL_TEX_EMISSION) uniform sampler3D u_emission; // med.shape.w: emission eps (W m^-3 sr^-1)
 layout(std140, binding = VEIL_UBO_MARCH) uniform veil_march_ubo { veil_march_block u; };
+#ifdef VEIL_MARCH_DEEP
+layout(std430, binding = VEIL_BIND_DEEP_COUNT) writeonly buffer veil_deep_count { uint deep_count[]; };
+layout(std430, binding = VEIL_BIND_DEEP_SAMPLES) writeonly buffer veil_deep_samples { float deep_samples[]; };
+// one pixel's deep state (render/deep.h): samples written, the open stretch's front (ray distance, mean T,
+// L + Lv there) and its last step's end
+uint d_pixel = 0u, d_n = 0u;
+bool d_open = false, d_matter = false;
+float d_t0 = 0.0, d_t1 = 0.0, d_T0 = 1.0, d_along = 1.0;
+vec3 d_L0 = vec3(0.0);
+
+float deep_mean(vec3 T) { return (T.r + T.g + T.b) / 3.0; }
+
+// opens a stretch at ray distance t unless one is open (before the step adds anything)
+void deep_open(float t, vec3 T, vec3 L, vec3 Lv)
+{
+    d_matter = true;
+    if (d_open) return;
+    d_open = true;
+    d_t0 = t, d_t1 = t;
+    d_T0 = deep_mean(T);
+    d_L0 = L + Lv;
+}
+
+void deep_close(vec3 T, vec3 L, vec3 Lv)
+{
+    if (!d_open) return;
+    d_open = false;
+    uint i = (d_pixel * uint(VEIL_MARCH_DEEP) + d_n) * uint(VEIL_DEEP_SAMPLE_FLOATS);
+    if (d_pixel >= uint(deep_count.length()) || i + 5u >= uint(deep_samples.length())) return;
+    vec3 c = (L + Lv - d_L0) / d_T0;
+    deep_samples[i + 0u] = c.r;
+    deep_samples[i + 1u] = c.g;
+    deep_samples[i + 2u] = c.b;
+    deep_samples[i + 3u] = 1.0 - deep_mean(T) / d_T0;
+    deep_samples[i + 4u] = d_t0 * d_along;
+    deep_samples[i + 5u] = d_t1 * d_along;
+    ++d_n;
+}
+
+// after a step ending at te: extend the open stretch over it, or close it at a gap; close it where its
+// opacity crossed a multiple of 1/R (unless it is the last one a pixel may have, or what follows is
+// below VEIL_DEEP_MIN_T)
+void deep_step(float te, vec3 T, vec3 L, vec3 Lv)
+{
+    if (!d_matter) {
+        if (d_n + 1u < uint(VEIL_MARCH_DEEP) && deep_mean(T) >= VEIL_DEEP_MIN_T) deep_close(T, L, Lv);
+        return;
+    }
+    d_matter = false;
+    d_t1 = te;
+    float R = float(VEIL_MARCH_DEEP), Tm = deep_mean(T);
+    if (d_n + 1u < uint(VEIL_MARCH_DEEP) && Tm >= VEIL_DEEP_MIN_T && floor(R * (1.0 - Tm)) > floor(R * (1.0 - d_T0)))
+        deep_close(T, L, Lv);
+}
+#endif
 //@include propagate/shaders/lit_medium.glsl
 
 uint hash32(uint x)
@@ -230,7 +293,11 @@ void main()
     uint h = hash32(uint(p.x) + hash32(uint(p.y) + hash32(u.flags.z)));
     float jitter = (float(h >> 8) + 1.0) * (1.0 / 16777216.0); // (0, 1]
     float t = t_begin;
-    bool first = true;
+    bool first = true, stop = false;
+#ifdef VEIL_MARCH_DEEP
+    d_pixel = uint(p.y - u.size.z) * uint(u.size.x) + uint(p.x);
+    d_along = along;
+#endif
     while (t < t_end && t < u.limits.x) {
         vec3 x0 = u.cam_pos.xyz + dir * t;
         bool in_ev = med.counts.z != 0 && t >= ev.x && t < ev.y;
@@ -243,6 +310,9 @@ void main()
             if (sp_slot(b, region) == 0u) {
                 float exit_t = t + sp_region_exit(q, dir, b, region) * sp.origin.w;
                 t = max(exit_t, t) + max(1e-4 * u.march.x, 2.4e-7 * abs(t));
+#ifdef VEIL_MARCH_DEEP
+                deep_step(t, T, L, Lv); // a gap: closes the open stretch
+#endif
                 continue;
             }
 #else
@@ -253,6 +323,9 @@ void main()
                 float exit_t = box_hit(u.cam_pos.xyz, dir, lo, lo + float(VEIL_BRICK) * med.shape.y, t, INF).y;
                 // past the exit by a hair that float t can hold (t + 1e-4 step may round to t)
                 t = max(exit_t, t) + max(1e-4 * u.march.x, 2.4e-7 * abs(t));
+#ifdef VEIL_MARCH_DEEP
+                deep_step(t, T, L, Lv); // a gap: closes the open stretch
+#endif
                 continue;
             }
 #endif
@@ -284,10 +357,16 @@ void main()
             vec3 eps = texture(u_emission, (x - med.tex_min.xyz) * med.tex_inv_size.xyz).rgb;
 #endif
             vec3 opt = med.sigma_t.rgb * rho_dt;
+#ifdef VEIL_MARCH_DEEP
+            if (any(greaterThan(eps, vec3(0.0)))) deep_open(t, T, L, Lv);
+#endif
             L += T * eps * dt * vec3(veil_step_integral(opt.r), veil_step_integral(opt.g), veil_step_integral(opt.b));
         }
 #endif
         if (rho_dt > 0.0) {
+#ifdef VEIL_MARCH_DEEP
+            deep_open(t, T, L, Lv);
+#endif
             vec3 opt = med.sigma_t.rgb * rho_dt;
             vec3 frac = vec3(veil_step_integral(opt.r), veil_step_integral(opt.g), veil_step_integral(opt.b));
             // sigma_s (rho_dt frac) = sigma_s (1 - exp(-opt)) / sigma_t <= 1: in this order (precise:
@@ -321,10 +400,18 @@ void main()
             depth_w += absorbed;
             P += rho_dt;
             T = T_next;
-            if (max(T_red.r, max(T_red.g, T_red.b)) < VEIL_MIN_TRANSMITTANCE) break;
+            stop = max(T_red.r, max(T_red.g, T_red.b)) < VEIL_MIN_TRANSMITTANCE;
         }
+#ifdef VEIL_MARCH_DEEP
+        deep_step(te, T, L, Lv);
+#endif
         t = te;
+        if (stop) break;
     }
+#ifdef VEIL_MARCH_DEEP
+    deep_close(T, L, Lv);
+    if (d_pixel < uint(deep_count.length())) deep_count[d_pixel] = d_n;
+#endif
     // the cache's part may dip below 0 where its lobe's correction outweighs what came along the ray
     // (a noisy or coarse lobe); radiance is not negative
     Lv = max(Lv, vec3(0.0));
