@@ -90,12 +90,17 @@ static void explain_lights(text* t, const veil_frame_plan* p)
     const veil_environment* env = &s->environment;
     if (env->present) {
         int used = 0;
-        for (int c = 0; c < env->cut_count; ++c, ++k) used += k < p->light_count && !memcmp(&p->lights[k], &env->cut[c], sizeof env->cut[c]);
-        put(t, "light %-3zu  environment %s: %d directional light%s of its median cut (lights %d)%s\n", env->light_index,
-            env->file ? env->file : "(a constant sky)", used, used == 1 ? "" : "s", env->lights,
-            env->cut_count == 0 ? "; black, lights nothing" : used < env->cut_count ? "; the rest: no medium" : "");
-        for (int c = 0; c < env->cut_count; ++c) {
-            const veil_light* L = &env->cut[c];
+        const veil_env_cut* cut = veil_env_cut_for(env, veil_quality_rung_of(p->o.quality)->env_lights);
+        const int count = cut ? cut->count : 0;
+        for (int c = 0; c < count; ++c, ++k) used += k < p->light_count && !memcmp(&p->lights[k], &cut->lights[c], sizeof *cut->lights);
+        put(t, "light %-3zu  environment %s: %d directional light%s of its median cut into %d%s (%s)%s\n",
+            env->light_index, env->file ? env->file : "(a constant sky)", used, used == 1 ? "" : "s", cut ? cut->k : 0,
+            cut && cut->k < (env->lights > 0 ? env->lights : veil_quality_rung_of(p->o.quality)->env_lights)
+                ? ", the room the other lights leave" : "",
+            env->lights > 0 ? "its \"lights\"" : "the quality's", count == 0 ? "; black, lights nothing"
+                                                  : used < count ? "; the rest: no medium" : "");
+        for (int c = 0; c < count; ++c) {
+            const veil_light* L = &cut->lights[c];
             put(t, "           cut %-2d direction [%.9g, %.9g, %.9g] irradiance [%.9g, %.9g, %.9g]\n", c, L->direction[0],
                 L->direction[1], L->direction[2], L->color[0], L->color[1], L->color[2]);
         }

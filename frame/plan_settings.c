@@ -24,10 +24,10 @@
  * default 24 a side cost 0.2-0.3 of the 40 a side the cache has, for
  * 4x4-block errors of 8.9-9.1 % against 7.5-9.3 %. */
 static const veil_quality_rung rungs[VEIL_QUALITY_COUNT] = {
-    [VEIL_QUALITY_DRAFT] = {1.0f, VEIL_OPV_LIGHT_SPACE, 1.0f, 4.0f, 1LL << 16, 24, 0, 0.0f, 0},
-    [VEIL_QUALITY_DEFAULT] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.5f, 4.0f, 1LL << 18, 40, 16, 2.0f, 24},
-    [VEIL_QUALITY_HIGH] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.35f, 4.0f, 1LL << 20, 64, 16, 2.0f, 64},
-    [VEIL_QUALITY_MAX] = {0.25f, VEIL_OPV_LIGHT_SPACE, 0.25f, 4.0f, 1LL << 22, 96, 64, 2.0f, 48},
+    [VEIL_QUALITY_DRAFT] = {1.0f, VEIL_OPV_LIGHT_SPACE, 1.0f, 4.0f, 1LL << 16, 24, 0, 0.0f, 0, VEIL_ENV_LIGHTS_DRAFT},
+    [VEIL_QUALITY_DEFAULT] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.5f, 4.0f, 1LL << 18, 40, 16, 2.0f, 24, VEIL_ENV_LIGHTS_DEFAULT},
+    [VEIL_QUALITY_HIGH] = {0.5f, VEIL_OPV_LIGHT_SPACE, 0.35f, 4.0f, 1LL << 20, 64, 16, 2.0f, 64, VEIL_ENV_LIGHTS_HIGH},
+    [VEIL_QUALITY_MAX] = {0.25f, VEIL_OPV_LIGHT_SPACE, 0.25f, 4.0f, 1LL << 22, 96, 64, 2.0f, 48, VEIL_ENV_LIGHTS_HIGH},
 };
 
 const veil_quality_rung* veil_quality_rung_of(veil_quality q)
@@ -78,15 +78,16 @@ static int light_reaches(const veil_light* l, const veil_grid* g)
     return angle <= spread;
 }
 
-int veil_render_lights(const veil_scene* s, const veil_grid* g, veil_light* out)
+int veil_render_lights(const veil_scene* s, const veil_grid* g, int env_lights, veil_light* out)
 {
     int n = 0;
     if (!g && count_fogs(s) == 0) return 0; /* no medium at all */
     for (size_t l = 0; l < s->light_count && n < VEIL_MAX_LIGHTS; ++l)
         if (light_reaches(&s->lights[l], g)) out[n++] = s->lights[l];
     /* the environment as directional lights, after the scene's (scene/environment.h: the median cut) */
-    for (int l = 0; l < s->environment.cut_count && n < VEIL_MAX_LIGHTS; ++l)
-        if (light_reaches(&s->environment.cut[l], g)) out[n++] = s->environment.cut[l];
+    const veil_env_cut* cut = veil_env_cut_for(&s->environment, env_lights);
+    for (int l = 0; cut && l < cut->count && n < VEIL_MAX_LIGHTS; ++l)
+        if (light_reaches(&cut->lights[l], g)) out[n++] = cut->lights[l];
     return n;
 }
 
@@ -141,7 +142,7 @@ void veil_frame_plan_volume(veil_frame_plan* p, const veil_grid* g, int sparse, 
 {
     p->grid = g;
     p->sparse = g ? sparse : 0;
-    p->light_count = veil_render_lights(p->scene, g, p->lights);
+    p->light_count = veil_render_lights(p->scene, g, veil_quality_rung_of(p->o.quality)->env_lights, p->lights);
     const veil_multiple* m = &p->scene->multiple;
     /* the light cache carries all of the emission's light (volume/cache.h): it needs no emission lights */
     const int cache = field_kind(m) == VEIL_FIELD_CACHE;

@@ -89,13 +89,14 @@ typedef struct veil_quality_rung {
     int gather_rays;         /* the cache's later light gathered towards the camera: rays a cell (0: off) */
     float gather_step;       /* and its rays' steps, in the cache's cells (render/march.h) */
     int gather_cells;        /* and its cells along the grid's longest side, at most */
+    int env_lights;          /* an environment light as this many directional lights (scene/environment.h) */
 } veil_quality_rung;
 const veil_quality_rung* veil_quality_rung_of(veil_quality q); /* UNSET: the default rung */
 
 /* The lights of s that add light inside the box of g (NULL: fog only, no
  * box), in scene order, into out (VEIL_MAX_LIGHTS): zero colour never
  * does; a spot whose outer cone misses the box's bounding sphere does not. */
-int veil_render_lights(const veil_scene* s, const veil_grid* g, veil_light* out);
+int veil_render_lights(const veil_scene* s, const veil_grid* g, int env_lights, veil_light* out);
 
 /* A frame's plan: every setting resolved once, read by every row. */
 typedef struct veil_frame_plan {

@@ -226,7 +226,7 @@ static veil_result parse_environment(const ctx* c, const cJSON* e, const jpath* 
     const jpath fp = {ep, "file", 0}, ip = {ep, "intensity", 0};
     TRY(veil__jr_check_keys(c, e, ep, ENV_KEYS));
     env->present = 1;
-    env->lights = VEIL_ENV_DEFAULT_LIGHTS;
+    env->lights = 0; /* the quality rung's */
     float color[3] = {1.0f, 1.0f, 1.0f};
     double intensity = 1.0, rotation = 0.0;
     const int has_color = cJSON_GetObjectItemCaseSensitive(e, "color") != NULL;
@@ -299,10 +299,10 @@ static veil_result parse_lights(const ctx* c, const cJSON* root, veil_scene* s)
         if (kind == VEIL_LIGHT_SPOT) TRY(parse_cone(c, e, &ep, l));
     }
     s->light_count = n; /* (the environment is one of the VEIL_MAX_LIGHTS entries: n < VEIL_MAX_LIGHTS with it) */
-    if (s->environment.present && s->environment.lights > VEIL_MAX_LIGHTS - (int)n)
-        s->environment.lights = VEIL_MAX_LIGHTS - (int)n; /* (docs/scene-format.md: the room the other lights leave) */
-    if (s->environment.present)
-        s->environment.cut_count = veil_env_median_cut(&s->environment, s->environment.lights, s->environment.cut);
+    if (s->environment.present) { /* (at most the room the other lights leave: docs/scene-format.md) */
+        static const int rungs[VEIL_ENV_CUTS] = {VEIL_ENV_LIGHTS_DEFAULT, VEIL_ENV_LIGHTS_DRAFT, VEIL_ENV_LIGHTS_HIGH};
+        veil_env_make_cuts(&s->environment, VEIL_MAX_LIGHTS - (int)n, rungs, VEIL_ENV_CUTS);
+    }
     return VEIL_OK;
 }
 

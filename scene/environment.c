@@ -229,6 +229,40 @@ int veil_env_median_cut(const veil_environment* e, int max, veil_light* out)
     return lights;
 }
 
+void veil_env_make_cuts(veil_environment* e, int room, const int* rungs, int n)
+{
+    e->cut_sets = 0;
+    e->room = room < 0 ? 0 : room > VEIL_MAX_LIGHTS ? VEIL_MAX_LIGHTS : room;
+    if (!e->present || e->room == 0) return;
+    const int one = e->lights;
+    if (one > 0) rungs = &one, n = 1;
+    for (int r = 0; r < n && e->cut_sets < VEIL_ENV_CUTS; ++r) {
+        int k = rungs[r] < e->room ? rungs[r] : e->room, seen = 0;
+        for (int c = 0; c < e->cut_sets; ++c) seen |= e->cuts[c].k == k;
+        if (seen || k < 1) continue;
+        veil_env_cut* cut = &e->cuts[e->cut_sets++];
+        cut->k = k;
+        cut->count = veil_env_median_cut(e, k, cut->lights);
+    }
+}
+
+const veil_env_cut* veil_env_cut_for(const veil_environment* e, int want)
+{
+    if (!e || !e->present || e->cut_sets == 0) return NULL;
+    int k = e->lights > 0 ? e->lights : want;
+    if (k > e->room) k = e->room;
+    for (int c = 0; c < e->cut_sets; ++c)
+        if (e->cuts[c].k == k) return &e->cuts[c];
+    return &e->cuts[0];
+}
+
+int veil_env_cut_max(const veil_environment* e)
+{
+    int m = 0;
+    for (int c = 0; e && e->present && c < e->cut_sets; ++c) m = e->cuts[c].count > m ? e->cuts[c].count : m;
+    return m;
+}
+
 /* ---- importance sampling ---------------------------------------------- */
 
 veil_result veil_env_dist_make(veil_environment* e, veil_error* err)

@@ -47,10 +47,20 @@
 #include "../core/result.h"
 #include "light.h"
 
-#define VEIL_ENV_DEFAULT_LIGHTS 8 /* directional lights the GPU pipeline carries it as (docs/accuracy.md) */
+#define VEIL_ENV_CUTS 3 /* median cuts a scene keeps: the given count's, or one for each quality rung's count */
+/* The quality rungs' counts (frame/stages.h; docs/accuracy.md measured them): draft, default, high and max */
+#define VEIL_ENV_LIGHTS_DRAFT 4
+#define VEIL_ENV_LIGHTS_DEFAULT 8
+#define VEIL_ENV_LIGHTS_HIGH 16
 #define VEIL_ENV_MAX_TEXELS ((size_t)1 << 25) /* an 8K map, 8192 x 4096 */
 
 typedef struct veil_env_dist veil_env_dist;
+
+/* A median cut: k regions asked for, count lights made (regions without light make none). */
+typedef struct veil_env_cut {
+    int k, count;
+    veil_light lights[VEIL_MAX_LIGHTS];
+} veil_env_cut;
 
 typedef struct veil_environment {
     int present;       /* 0: none (every other field zero) */
@@ -58,12 +68,14 @@ typedef struct veil_environment {
     float* rgb;        /* width * height * 3 radiances, intensity included (owned) */
     float rotation_deg;
     int up_z;          /* 1: "up": "z", the world's +Z is the map's zenith (0: +Y) */
-    int lights;        /* "lights": how many directional lights the GPU pipeline carries it as, 1..VEIL_MAX_LIGHTS */
+    int lights;        /* "lights": how many directional lights the GPU pipeline carries it as, 1..VEIL_MAX_LIGHTS;
+                          0: the quality rung's (frame/stages.h: draft 4, default 8, high and max 16) */
+    int room;          /* at most this many: VEIL_MAX_LIGHTS less the scene's other lights */
     char* file;        /* the map's file, resolved (owned); NULL: a constant colour */
     size_t light_index; /* where it stood among the scene file's lights (for messages) */
     veil_env_dist* dist; /* the sampling distribution, made on first need (veil_env_dist_make; owned) */
-    veil_light cut[VEIL_MAX_LIGHTS]; /* veil_env_median_cut's `lights` lights, made once when the scene is read */
-    int cut_count;
+    veil_env_cut cuts[VEIL_ENV_CUTS]; /* made once when the scene is read (veil_env_make_cuts) */
+    int cut_sets;
 } veil_environment;
 
 /* Releases what e owns; leaves it zeroed. */
@@ -90,6 +102,15 @@ void veil_env_integral(const veil_environment* e, double out[3]);
  * number of lights written (0 when the environment is black); the sum of
  * their irradiances is veil_env_integral's, up to rounding. */
 int veil_env_median_cut(const veil_environment* e, int max, veil_light* out);
+
+/* Makes e's cuts for `room` lights at most: the one of e->lights, or with lights 0 one for each of the
+ * counts rungs[0 .. n) (each at most room; equal ones once). */
+void veil_env_make_cuts(veil_environment* e, int room, const int* rungs, int n);
+/* The cut for `want` lights (e->lights when set, else the rung's `want`), at most e->room: the kept cut of
+ * that count, else the first; NULL without an environment. */
+const veil_env_cut* veil_env_cut_for(const veil_environment* e, int want);
+/* The most lights any of e's cuts makes (0 without an environment). */
+int veil_env_cut_max(const veil_environment* e);
 
 /* Importance sampling by luminance x solid angle (a texel chosen with
  * probability proportional to its luminance times its solid angle, then a

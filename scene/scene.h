@@ -283,7 +283,7 @@ void veil_scene_free(veil_scene* s); /* accepts NULL and zeroed scenes */
 /* The lights the GPU pipeline carries: the scene's, and the environment's directional lights (its median cut). */
 static inline size_t veil_scene_light_total(const veil_scene* s)
 {
-    return s->light_count + (size_t)(s->environment.present ? s->environment.cut_count : 0);
+    return s->light_count + (size_t)veil_env_cut_max(&s->environment);
 }
 
 /* Copies a grid into s under `name`, replacing one of the same name (an

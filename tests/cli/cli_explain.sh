@@ -19,6 +19,23 @@ grep -q '^render     every frame: runs' "$tmp/plan.txt" || fail "no render plan"
 [ -z "$(ls "$tmp" | grep -v plan.txt)" ] || fail "explain wrote files: $(ls "$tmp")"
 ok
 
+# an environment light: its median cut into the quality rung's count (draft 4, default 8, high 16), or
+# into its own "lights", at most the room the scene's other lights leave
+sed 's/"lights": \[/"lights": [{"type": "environment", "color": [0.2, 0.3, 0.5]},/' "$scenes/demo.json" > "$tmp/sky.json"
+for q in draft:4:3 default:8:3 high:13:3; do
+  IFS=: read -r rung k others <<< "$q"
+  "$veil" render "$tmp/sky.json" --explain --quality "$rung" > "$tmp/env.txt" 2>&1 || fail "explain, sky: $(cat "$tmp/env.txt")"
+  grep -q "^light 0    environment (a constant sky): $k directional lights of its median cut into $k" "$tmp/env.txt" ||
+    fail "quality $rung: not $k lights: $(cat "$tmp/env.txt")"
+  grep -q "^propagate  frame 0: runs, $((k + others)) lights" "$tmp/env.txt" || fail "quality $rung: $((k + others)) lights not propagated"
+  [ "$(grep -c '^           cut ' "$tmp/env.txt")" = "$k" ] || fail "quality $rung: the cut's $k lights not listed"
+done
+grep -q "into 13, the room the other lights leave (the quality's)" "$tmp/env.txt" || fail "room not said: $(cat "$tmp/env.txt")"
+sed 's/"color": \[0.2, 0.3, 0.5\]}/"color": [0.2, 0.3, 0.5], "lights": 2}/' "$tmp/sky.json" > "$tmp/sky2.json"
+"$veil" render "$tmp/sky2.json" --explain --quality high > "$tmp/env.txt" 2>&1 || fail "explain, sky 2: $(cat "$tmp/env.txt")"
+grep -q "median cut into 2 (its \"lights\")" "$tmp/env.txt" || fail "the scene's lights 2 not kept: $(cat "$tmp/env.txt")"
+ok
+
 # needs no GPU: a broken driver does not matter to it
 GALLIUM_DRIVER=nope VEIL_DEVICE=software "$veil" render "$scenes/demo.json" --explain > /dev/null 2>&1 \
   || fail "explain needed a GL context"

@@ -284,9 +284,15 @@ static void test_scene(void)
     if (r == VEIL_OK) {
         CHECK(s.light_count == 1 && s.environment.present && s.environment.width == 1 &&
               fabsf(s.environment.rgb[2] - 1.4f) < 1e-6f && s.environment.rotation_deg == 45.0f &&
-              s.environment.lights == VEIL_ENV_DEFAULT_LIGHTS && s.environment.cut_count == VEIL_ENV_DEFAULT_LIGHTS &&
-              s.environment.light_index == 1 && veil_scene_light_total(&s) == 1 + VEIL_ENV_DEFAULT_LIGHTS,
+              s.environment.lights == 0 && s.environment.cut_sets == 3 && s.environment.room == 15 &&
+              s.environment.light_index == 1 && veil_scene_light_total(&s) == 1 + 15,
               "constant sky read wrong");
+        /* no "lights": a cut for each rung's count, at most the room (15) */
+        const veil_env_cut* c8 = veil_env_cut_for(&s.environment, VEIL_ENV_LIGHTS_DEFAULT);
+        const veil_env_cut* c4 = veil_env_cut_for(&s.environment, VEIL_ENV_LIGHTS_DRAFT);
+        const veil_env_cut* c16 = veil_env_cut_for(&s.environment, VEIL_ENV_LIGHTS_HIGH);
+        CHECK(c8 && c8->k == 8 && c8->count == 8 && c4 && c4->count == 4 && c16 && c16->k == 15 && c16->count == 15,
+              "the rungs' cuts: %d, %d, %d lights", c8 ? c8->count : -1, c4 ? c4->count : -1, c16 ? c16->count : -1);
         veil_scene_free(&s);
     }
     write_map("sky.exr", 16, 8, 0.25f, 0.25f);
@@ -294,7 +300,8 @@ static void test_scene(void)
     CHECK(r == VEIL_OK, "map: %s", e.msg);
     if (r == VEIL_OK) {
         CHECK(s.light_count == 0 && s.environment.width == 16 && s.environment.height == 8 &&
-              s.environment.rgb[3 * 17 + 2] == 1.0f && s.environment.cut_count == 3 && s.environment.up_z == 1 &&
+              s.environment.rgb[3 * 17 + 2] == 1.0f && s.environment.cut_sets == 1 &&
+              veil_env_cut_for(&s.environment, VEIL_ENV_LIGHTS_HIGH)->count == 3 && s.environment.up_z == 1 &&
               strstr(s.environment.file, "sky.exr") != NULL, "map read wrong");
         veil_scene_free(&s);
     }
@@ -303,7 +310,8 @@ static void test_scene(void)
     for (int l = 0; l < 15; ++l) strcat(many, POINT ",");
     strcat(many, "{'type':'environment','color':[1,1,1]}]}");
     r = parse(many, &s, &e);
-    CHECK(r == VEIL_OK && s.environment.lights == 1 && s.environment.cut_count == 1, "15 lights: %s", e.msg);
+    CHECK(r == VEIL_OK && s.environment.room == 1 && s.environment.cut_sets == 1 &&
+          veil_env_cut_for(&s.environment, VEIL_ENV_LIGHTS_HIGH)->count == 1, "15 lights: %s", e.msg);
     if (r == VEIL_OK) veil_scene_free(&s);
     write_map("nan.exr", 16, 8, 0.25f, NAN);
     write_map("small.exr", 1, 1, 0.25f, 0.25f);
