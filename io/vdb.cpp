@@ -708,8 +708,9 @@ FloatGrid::Ptr grown_topology(const FloatGrid& g, int reach)
     FloatGrid::Ptr out = FloatGrid::create(0.0f);
     out->setTransform(g.transform().copy());
     for (auto leaf = g.tree().cbeginLeaf(); leaf; ++leaf) {
-        if (leaf->isEmpty()) continue;
-        CoordBBox b = leaf->getNodeBoundingBox();
+        CoordBBox b; // the leaf's active voxels' box (tighter than the node's at the grid's edge)
+        leaf->evalActiveBoundingBox(b, true);
+        if (b.empty()) continue;
         b.expand(reach);
         out->tree().sparseFill(b, 0.0f, true);
     }
@@ -1221,17 +1222,28 @@ veil_result veil_vdb_advect_mean(veil_vdb* g, const veil_vdb_velocity* vel, cons
                 for (int j = 0; j < 3; ++j) v_at.k[i][j] = kc(i, j) * d->scale;
             for (auto it = leaf.beginValueOn(); it; ++it) {
                 const Coord c = it.getCoord();
+                const openvdb::Vec3d x(c.x(), c.y(), c.z()), vx = v_at(x); // both sides start at x
                 double sum = 0.0;
                 for (const std::vector<double>* side : {&pos, &neg}) {
-                    openvdb::Vec3d y(c.x(), c.y(), c.z());
-                    double t = 0.0;
+                    // backwards along v for h > 0: the first step a midpoint (RK2) one, the next ones
+                    // two-step Adams-Bashforth for steps h after h_prev (second order as well, one
+                    // velocity read a step): y -= h ((1 + q/2) v(y) - (q/2) v(y_prev)), q = h / h_prev
+                    openvdb::Vec3d y = x, v_prev = vx;
+                    double t = 0.0, h_prev = 0.0;
                     for (double tk : *side) {
                         const double span = tk - t;
                         const double steps = std::max(1.0, std::ceil(std::fabs(span) / step_time));
                         const double h = span / steps;
-                        for (double s = 0; s < steps; ++s) { // midpoint (RK2): backwards along v for h > 0
-                            const openvdb::Vec3d mid = y - 0.5 * h * v_at(y);
-                            y -= h * v_at(mid);
+                        for (double s = 0; s < steps && h != 0.0; ++s) {
+                            if (h_prev == 0.0) {
+                                y -= h * v_at(y - 0.5 * h * vx);
+                            } else {
+                                const openvdb::Vec3d vy = v_at(y);
+                                const double q = h / h_prev;
+                                y -= h * ((1.0 + 0.5 * q) * vy - (0.5 * q) * v_prev);
+                                v_prev = vy;
+                            }
+                            h_prev = h;
                         }
                         t = tk;
                         sum += openvdb::tools::BoxSampler::sample(sacc, y);

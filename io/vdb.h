@@ -196,9 +196,11 @@ double veil_vdb_velocity_max(const veil_vdb_velocity* v);
  * traced backwards through the field, dX/ds = -sign(t) scale v(X) for s
  * in [0, |t|] (semi-Lagrangian; the field is the frame's, held steady over
  * the times). The path is walked outwards from t = 0 to each side's times
- * in turn, each step a midpoint (RK2) step moving at most max_step_voxels
- * of g's smallest voxel edge; g is sampled trilinearly (BoxSampler) at
- * each t_k, v at the path's points. A constant field gives exactly g
+ * in turn, in steps moving at most max_step_voxels of g's smallest voxel
+ * edge: the first a midpoint (RK2) step, the next ones two-step
+ * Adams-Bashforth (second order too, with one velocity read a step instead
+ * of two); g is sampled trilinearly (BoxSampler) at each t_k, v at the
+ * path's points. A constant field gives exactly g
  * shifted by -scale v t_k. Only the voxels the paths can reach are made:
  * g's active voxels and tiles dilated by reach = ceil(max|v| scale
  * max|t_k| / edge) + 1 voxels (the trilinear support). Runs in parallel

@@ -34,7 +34,8 @@
  * "unit": "second", without / fps for "frame"): consecutive samples are at
  * most one voxel apart, as far as the cap allows (capped: D / N voxels,
  * and --stats says so). The paths are walked in steps of at most one voxel
- * (midpoint rule). The velocity is sampled along the path, not only at x.
+ * (second order: a midpoint step, then Adams-Bashforth), the velocity read
+ * along the path, not only at x.
  */
 #ifndef VEIL_MOTION_BLUR_H
 #define VEIL_MOTION_BLUR_H
