@@ -279,7 +279,9 @@ void value_files()
 //     16) (a second source that fixes the volume's box whatever the puff's shift); "vel" the
 //     constant vector (1, 0, 0) (m per unit of time) on the active box [-40, 40]^3, "vel_d"
 //     the same as vec3d, "vel_zero" (0, 0, 0) there, "wind.x", "wind.y", "wind.z" the same
-//     field as three float grids (1, 0, 0); "speed" a float grid (not a vector)
+//     field as three float grids (1, 0, 0); "speed" a float grid (not a vector); "swirl" a
+//     rotation about the z axis through world (-1, 0, 0) at 1 rad per unit of time, v = (-y,
+//     x + 1, 0) at world (x, y, z), on [-40, 40]^3 (linear, so its trilinear field is exact)
 //   moving.000F.vdb (F = 1, 2, 3): "density" the puff at index (4 (F - 2), 0, 0), "vel"
 //     (12, 0, 0) m/s on [-40, 40]^3: at 24 fps the puff's own motion, 4 voxels a frame
 FloatGrid::Ptr blur_puff(int x)
@@ -307,7 +309,10 @@ void blur_files()
     anchor->tree().setValueOn(Coord(-16), 0.0f);
     anchor->tree().setValueOn(Coord(16), 0.0f);
     speed->tree().setValue(Coord(0), 1.0f);
-    openvdb::GridPtrVec grids = {blur_puff(0), anchor, vec("vel", 1.0f), vd, vec("vel_zero", 0.0f), speed};
+    openvdb::Vec3SGrid::Ptr swirl = vec("swirl", 0.0f);
+    for (auto p = box.begin(); p; ++p)
+        swirl->tree().setValue(*p, openvdb::Vec3s(-0.125f * (float)(*p).y(), 0.125f * (float)(*p).x() + 1.0f, 0.0f));
+    openvdb::GridPtrVec grids = {blur_puff(0), anchor, vec("vel", 1.0f), vd, vec("vel_zero", 0.0f), speed, swirl};
     for (int a = 0; a < 3; ++a) {
         FloatGrid::Ptr w = float_grid((std::string("wind.") + "xyz"[a]).c_str(), 0.125);
         w->tree().fill(box, a == 0 ? 1.0f : 0.0f, true);
