@@ -62,6 +62,34 @@ int veil_cli_parse_float(const char* s, float lo, float hi, float* out)
     return 1;
 }
 
+int veil_cli_parse_shutter(const char* s, int* set, float sh[2])
+{
+    if (!strcmp(s, "off")) {
+        *set = -1;
+        return 1;
+    }
+    const char* comma = strchr(s, ',');
+    char open[64];
+    if (!comma || (size_t)(comma - s) >= sizeof open) return 0;
+    memcpy(open, s, (size_t)(comma - s));
+    open[comma - s] = '\0';
+    const float lim = (float)VEIL_MAX_SHUTTER_FRAMES;
+    if (!veil_cli_parse_float(open, -lim, lim, &sh[0]) || !veil_cli_parse_float(comma + 1, -lim, lim, &sh[1]) ||
+        !(sh[1] >= sh[0]))
+        return 0;
+    *set = 1;
+    return 1;
+}
+
+void veil_cli_apply_shutter(veil_scene* scene, int set, const float sh[2])
+{
+    if (set < 0) scene->camera.has_shutter = 0;
+    if (set > 0) {
+        scene->camera.has_shutter = 1;
+        scene->camera.shutter[0] = sh[0], scene->camera.shutter[1] = sh[1];
+    }
+}
+
 veil_result veil_cli_check_output_folder(const char* path, veil_error* err)
 {
     char dir[4096];

@@ -19,6 +19,11 @@ void veil_cli_prefix_error(veil_error* err, const char* file);
 /* A whole decimal integer in [lo, hi] / a number in [lo, hi]: 1, else 0. */
 int veil_cli_parse_int(const char* s, long lo, long hi, long* out);
 int veil_cli_parse_float(const char* s, float lo, float hi, float* out);
+/* --shutter: "OPEN,CLOSE" (frames relative to the frame, each in [-4, 4],
+ * open <= close) sets *set = 1 and sh; "off" sets *set = -1. 1, else 0. */
+int veil_cli_parse_shutter(const char* s, int* set, float sh[2]);
+/* What --shutter asked for, over the scene's camera.shutter (set 0: the scene's). */
+void veil_cli_apply_shutter(veil_scene* scene, int set, const float sh[2]);
 /* VEIL_ERR_IO naming the path when the folder it would be written to does
  * not exist (checked before any work, so nothing is written half). */
 veil_result veil_cli_check_output_folder(const char* path, veil_error* err);

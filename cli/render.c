@@ -25,6 +25,8 @@ typedef struct render_args {
     veil_opv_method method;
     veil_quality quality;
     int stats, explain, aovs;
+    int shutter_set; /* --shutter: 1 the values, -1 off, 0 the scene's */
+    float shutter[2];
 } render_args;
 
 static int parse_render_args(int argc, char** argv, render_args* a)
@@ -39,7 +41,8 @@ static int parse_render_args(int argc, char** argv, render_args* a)
         int takes = !strcmp(s, "-o") || !strcmp(s, "--png") || !strcmp(s, "--width") || !strcmp(s, "--height") ||
                     !strcmp(s, "--step") || !strcmp(s, "--seed") || !strcmp(s, "--method") ||
                     !strcmp(s, "--turntable") || !strcmp(s, "--quality") || !strcmp(s, "--od-spacing") ||
-                    !strcmp(s, "--deep") || !strcmp(s, "--deep-samples");
+                    !strcmp(s, "--deep") || !strcmp(s, "--deep-samples") ||
+                    !strcmp(s, "--shutter");
         if (takes && !v) return veil_cli_usage_error("%s needs a value", s);
         if (!strcmp(s, "-o")) a->exr = v;
         else if (!strcmp(s, "--png")) a->png = v;
@@ -63,6 +66,10 @@ static int parse_render_args(int argc, char** argv, render_args* a)
         } else if (!strcmp(s, "--quality")) {
             if (!veil_quality_parse(v, &a->quality))
                 return veil_cli_usage_error("--quality: expected draft, default, high or max, got '%s'", v);
+        } else if (!strcmp(s, "--shutter")) {
+            if (!veil_cli_parse_shutter(v, &a->shutter_set, a->shutter))
+                return veil_cli_usage_error("--shutter: expected OPEN,CLOSE (frames, each in -4..4, OPEN <= CLOSE) or "
+                                            "off, got '%s'", v);
         } else if (!strcmp(s, "--od-spacing")) {
             char across[64];
             const char* comma = strchr(v, ',');
@@ -93,6 +100,7 @@ static int explain(const render_args* a)
     veil_scene scene;
     veil_result r = veil_scene_load(a->scene, &scene, &err);
     if (r != VEIL_OK) return veil_cli_fail(r, &err);
+    veil_cli_apply_shutter(&scene, a->shutter_set, a->shutter);
     veil_render_opts opts = {.width = (int)a->width, .height = (int)a->height, .step_voxels = a->step,
                              .seed = (uint32_t)a->seed, .method = a->method, .quality = a->quality,
                              .sun_across = a->sun_across, .sun_along = a->sun_along};
@@ -117,6 +125,7 @@ int veil_cmd_render(int argc, char** argv)
     veil_scene scene;
     veil_result r = veil_scene_load(a.scene, &scene, &err);
     if (r != VEIL_OK) return veil_cli_fail(r, &err);
+    veil_cli_apply_shutter(&scene, a.shutter_set, a.shutter);
     /* the run's files before any work (cli/run_files.h): the scene and what it reads, every frame's EXR and
      * PNG of --turntable N (OUT_0000.exr ...) and their staging names (issue 22: s_0001.json was
      * overwritten); then their folders, made */

@@ -34,6 +34,8 @@ typedef struct tt_args {
     veil_opv_method method;
     veil_quality quality;
     veil_orbit orbit;
+    int shutter_set; /* --shutter: 1 the values, -1 off, 0 the scene's */
+    float shutter[2];
 } tt_args;
 
 static int parse_vec3(const char* v, float out[3])
@@ -110,6 +112,10 @@ static int parse_args(int argc, char** argv, tt_args* a)
         } else if (!strcmp(s, "--method")) {
             if (!veil_opv_method_parse(v, &a->method))
                 return veil_cli_usage_error("--method: expected default, jacobi, jacobi-corrected, sweep, semi-lagrangian or light-space, got '%s'", v);
+        } else if (!strcmp(s, "--shutter")) {
+            if (!veil_cli_parse_shutter(v, &a->shutter_set, a->shutter))
+                return veil_cli_usage_error("--shutter: expected OPEN,CLOSE (frames, each in -4..4, OPEN <= CLOSE) or "
+                                            "off, got '%s'", v);
         } else if (!strcmp(s, "--quality")) {
             if (!veil_quality_parse(v, &a->quality))
                 return veil_cli_usage_error("--quality: expected draft, default, high or max, got '%s'", v);
@@ -273,6 +279,7 @@ int veil_cmd_turntable(int argc, char** argv)
     veil_scene scene;
     veil_result r = veil_scene_load(a.scene, &scene, &err);
     if (r != VEIL_OK) return veil_cli_fail(r, &err);
+    veil_cli_apply_shutter(&scene, a.shutter_set, a.shutter);
     long count = veil_frame_range_count(&a.range);
     if (a.explain) {
         veil_render_opts opts = opts_of(&a, a.range.first, NULL);

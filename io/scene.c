@@ -22,13 +22,13 @@
 #define SCENE_MAX_FILE_BYTES ((size_t)256 << 20) /* 256 MiB */
 
 static const char* const ROOT_KEYS[] = {"camera", "medium", "lights", "background", "multiple_scattering", "quality",
-                                        "deep", NULL};
+                                        "deep", "fps", NULL};
 static const char* const DEEP_KEYS[] = {"samples", NULL};
 static const range R_DEEP_SAMPLES = {1, VEIL_DEEP_MAX_SAMPLES, false, false, true, "an integer in [1, 64]"};
 _Static_assert(VEIL_DEEP_MAX_SAMPLES == 64, "R_DEEP_SAMPLES' text (and --deep-samples' in cli/) names the bound");
 static const char* const QUALITIES[] = {"draft", "default", "high", "max", NULL}; /* = veil_quality - 1 */
 static const char* const CAMERA_KEYS[] = {"position", "look_at", "up", "fov_y_deg", "fov_deg", "sensor_fit", "shift",
-                                          "clip", "width", "height", NULL};
+                                          "clip", "shutter", "width", "height", NULL};
 static const char* const SENSOR_FITS[] = {"vertical", "horizontal", "auto", NULL}; /* = veil_sensor_fit */
 static const char* const MEDIUM_KEYS[] = {"sigma_a", "sigma_s", "phase", "max_resolution", "representation",
                                            "sources", NULL};
@@ -104,6 +104,17 @@ static veil_result parse_camera(const ctx* c, const cJSON* root, veil_camera* ca
         if (!(cam->clip[0] >= 0.0f && cam->clip[1] > cam->clip[0]))
             return veil__jr_fail_at(c, &cp, "expected [near, far] with 0 <= near < far (m along the view axis), "
                                     "got [%g, %g]", cam->clip[0], cam->clip[1]);
+    }
+    /* the shutter, in frames around the frame: motion blur of the sources that give a velocity */
+    const jpath sp = {&p, "shutter", 0};
+    if (cJSON_GetObjectItemCaseSensitive(o, "shutter")) {
+        static const range frames = {-VEIL_MAX_SHUTTER_FRAMES, VEIL_MAX_SHUTTER_FRAMES, false, false, false,
+                                     "a number of frames in [-4, 4] (relative to the frame: scene/scene.h)"};
+        TRY(veil__jr_get_floats_in(c, o, &p, "shutter", false, 2, &frames, cam->shutter));
+        if (!(cam->shutter[1] >= cam->shutter[0]))
+            return veil__jr_fail_at(c, &sp, "expected [open, close] with open <= close (frames relative to the "
+                                    "frame), got [%g, %g]", cam->shutter[0], cam->shutter[1]);
+        cam->has_shutter = 1;
     }
     TRY(veil__jr_get_int(c, o, &p, "width", &VEIL__R_SIZE, &cam->width));
     TRY(veil__jr_get_int(c, o, &p, "height", &VEIL__R_SIZE, &cam->height));
@@ -344,6 +355,8 @@ static veil_result parse_root(const ctx* c, const cJSON* root, veil_scene* s)
     s->quality = (veil_quality)(q + 1);
     s->background_set = cJSON_GetObjectItemCaseSensitive(root, "background") != NULL;
     TRY(parse_deep(c, root, &s->deep_samples));
+    static const range fps = {0, VEIL_SCENE_MAX_FPS, true, false, false, "a number of frames per second in (0, 1000]"};
+    TRY(veil__jr_get_number(c, root, NULL, "fps", false, &fps, &s->fps));
     return parse_background(c, root, s->background);
 }
 
@@ -424,6 +437,7 @@ veil_result veil_scene_parse_in(const char* name, const char* json, size_t len, 
     s.camera = (veil_camera){.up = {0, 1, 0}, .fov_y_deg = VEIL_SCENE_DEFAULT_FOV_Y,
                              .width = VEIL_SCENE_DEFAULT_WIDTH, .height = VEIL_SCENE_DEFAULT_HEIGHT};
     s.medium.max_resolution = VEIL_SCENE_DEFAULT_MAX_RES;
+    s.fps = VEIL_SCENE_DEFAULT_FPS;
     veil_result r = parse_root(&c, root, &s);
     if (r == VEIL_OK) r = set_names(&c, &s);
     cJSON_Delete(root);

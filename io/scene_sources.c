@@ -15,10 +15,12 @@
 
 static const char* const SOURCE_TYPES[] = {"rbf", "rbf_random", "vdb", "exponential", "array", NULL}; /* = veil_source_type */
 static const char* const VDB_KEYS[] = {"type", "file", "grid", "density_scale", "level_set", "emission", "temperature",
-                                       "frame_offset", "transform", NULL};
+                                       "frame_offset", "transform", "velocity", NULL};
 static const char* const ARRAY_KEYS[] = {"type", "grid", "density_scale", "emission", "temperature", "transform", NULL};
 static const char* const TEMPERATURE_KEYS[] = {"grid", "scale", "offset", "intensity", NULL};
 static const char* const EMISSION_KEYS[] = {"grid", "scale", "color", NULL};
+static const char* const VELOCITY_KEYS[] = {"grid", "unit", "scale", NULL};
+static const char* const VELOCITY_UNITS[] = {"second", "frame", NULL}; /* = veil_velocity_unit */
 static const char* const FOG_KEYS[] = {"type", "density", "falloff", "direction", "origin", "bounds", NULL};
 static const char* const RBF_KEYS[] = {"type", "particles", "file", NULL};
 static const char* const RANDOM_KEYS[] = {"type", "count", "seed", "bounds", "radius", "amplitude", NULL};
@@ -174,6 +176,27 @@ static veil_result parse_transform(const ctx* c, const cJSON* so, const jpath* s
 
 static veil_result parse_grids(const ctx* c, const cJSON* so, const jpath* sp, veil_vdb_source* v, int array);
 
+/* "velocity": {"grid": name (default: found by name, io/vdb.h), "unit": "second" | "frame" ("second"),
+ * "scale": a number in [0, 1e6] (1)}: what the density moves with, for motion blur */
+static veil_result parse_velocity(const ctx* c, const cJSON* so, const jpath* sp, veil_vdb_source* v)
+{
+    const jpath p = {sp, "velocity", 0};
+    const cJSON* o;
+    TRY(veil__jr_get_container(c, so, &p, false, false, &o));
+    if (!o) return VEIL_OK;
+    TRY(veil__jr_check_keys(c, o, &p, VELOCITY_KEYS));
+    TRY(veil__get_string(c, o, &p, "grid", false, &v->velocity_grid));
+    int unit = VEIL_VELOCITY_PER_SECOND;
+    TRY(veil__jr_get_name(c, o, &p, "unit", VELOCITY_UNITS, &unit));
+    /* a scale beyond 1e6 turns any stored velocity into an absurd displacement; a negative one
+     * would run the flow backwards (write the shutter the other way round instead) */
+    static const range scale = {0, 1e6, false, false, false, "a number in [0, 1e6]"};
+    double s = 1.0;
+    TRY(veil__jr_get_number(c, o, &p, "scale", false, &scale, &s));
+    v->has_velocity = 1, v->velocity_unit = unit, v->velocity_scale = (float)s;
+    return VEIL_OK;
+}
+
 static veil_result parse_vdb(const ctx* c, const cJSON* so, const jpath* sp, veil_vdb_source* v)
 {
     const jpath fp = {sp, "file", 0};
@@ -204,6 +227,7 @@ static veil_result parse_vdb(const ctx* c, const cJSON* so, const jpath* sp, vei
             return veil__jr_fail_at(c, &(jpath){sp, "frame_offset", 0}, "only for a sequence (a file with #### or %%04d)");
         TRY(resolve_file(c, &fp, &v->file));
     }
+    TRY(parse_velocity(c, so, sp, v));
     return parse_grids(c, so, sp, v, 0);
 }
 

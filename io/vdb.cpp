@@ -26,6 +26,8 @@
 #include <openvdb/tools/Dense.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetUtil.h>
+#include <openvdb/tools/Prune.h>
+#include <openvdb/tree/LeafManager.h>
 #include <nanovdb/util/IO.h>
 #include <nanovdb/util/NanoToOpenVDB.h>
 #include "nanovdb_check.hpp"
@@ -46,6 +48,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <memory>
 #include <new>
 #include <fstream>
 #include <vector>
@@ -55,6 +58,8 @@ using openvdb::Coord;
 using openvdb::CoordBBox;
 using openvdb::FloatGrid;
 using openvdb::GridBase;
+using openvdb::Vec3SGrid;
+using openvdb::Vec3DGrid;
 
 struct veil_vdb {
     std::string path, name;
@@ -63,6 +68,14 @@ struct veil_vdb {
     openvdb::Index64 active = 0;
     std::string others;          // the file's other grids, "name (type)", comma-separated
     veil_vdb_values values{};    // the active values' range (all finite: checked when opened)
+};
+
+struct veil_vdb_velocity {
+    std::string path, name;      // name: "vel", or "vel.x/.y/.z" for a float triple
+    Vec3SGrid::Ptr grid;         // read-only once placed; inactive values 0
+    bool staggered = false;      // GRID_STAGGERED: a MAC grid, sampled with StaggeredBoxSampler
+    double lin[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}; // the placements' 3x3 (column vectors): vectors read lin v
+    double max = 0.0;            // max |lin v| over the active values
 };
 
 namespace {
@@ -132,6 +145,8 @@ private:
 };
 
 std::string quoted(const std::string& s) { return "'" + s + "'"; }
+// (for a non-const string, which std::quoted, found by ADL, would otherwise take)
+std::string quoted(std::string& s) { return "'" + s + "'"; }
 
 // Runs f, mapping every exception to a result: `what` prefixes the messages
 // of exceptions thrown by OpenVDB or the standard library (normally the file).
@@ -323,18 +338,22 @@ GridBase::Ptr choose(const std::string& path, const openvdb::GridPtrVec& grids, 
 // voxels are found from its mask and its buffer written directly; a tree
 // iterator over every inactive value (the tiles' too) took 7-10 ms of the
 // 18 ms it takes to open the shared smoke.vdb, this 3 ms.
-void zero_inactive(FloatGrid& grid)
+// (A velocity grid's too: its inactive vectors read 0.)
+template <typename GridT>
+void zero_inactive(GridT& grid)
 {
-    FloatGrid::TreeType& tree = grid.tree();
-    if (tree.background() != 0.0f) tree.root().setBackground(0.0f, true);
+    using V = typename GridT::ValueType;
+    const V zero = openvdb::zeroVal<V>();
+    typename GridT::TreeType& tree = grid.tree();
+    if (tree.background() != zero) tree.root().setBackground(zero, true);
     for (auto leaf = tree.beginLeaf(); leaf; ++leaf) {
-        float* d = leaf->buffer().data();
-        for (auto off = leaf->getValueMask().beginOff(); off; ++off) d[off.pos()] = 0.0f;
+        V* d = leaf->buffer().data();
+        for (auto off = leaf->getValueMask().beginOff(); off; ++off) d[off.pos()] = zero;
     }
-    FloatGrid::ValueOffIter it = grid.beginValueOff();
-    it.setMaxDepth(FloatGrid::ValueOffIter::LEAF_DEPTH - 1); // the inactive tiles above the leaves
+    typename GridT::ValueOffIter it = grid.beginValueOff();
+    it.setMaxDepth(GridT::ValueOffIter::LEAF_DEPTH - 1); // the inactive tiles above the leaves
     for (; it; ++it)
-        if (*it != 0.0f) it.setValue(0.0f);
+        if (*it != zero) it.setValue(zero);
 }
 
 // Calls f(value, voxels, leaf, offset[, coord]) for every value a voxel
@@ -493,7 +512,7 @@ void fill_info(const std::string& path, openvdb::io::File* file, const GridBase&
 // Gives grid the index-to-world map m (column vectors, last row 0 0 0 1),
 // refusing a singular or non-finite one (the reader and the resampler
 // invert it).
-void place(FloatGrid& grid, const double m[4][4], const char* label)
+void place(GridBase& grid, const double m[4][4], const char* label)
 {
     openvdb::Mat4d a; // row vectors: world = idx * a, so a is m transposed
     for (int r = 0; r < 4; ++r)
@@ -565,6 +584,182 @@ cJSON* grid_json(const veil_vdb_grid_info& g)
     }
     return o;
 }
+
+
+// ---- velocity (veil_vdb_velocity_*) -------------------------------------
+
+GridBase::Ptr find_grid(const openvdb::GridPtrVec& grids, const std::string& name)
+{
+    for (const auto& g : grids)
+        if (g->getName() == name) return g;
+    return nullptr;
+}
+
+bool is_vector(const GridBase& g) { return g.isType<Vec3SGrid>() || g.isType<Vec3DGrid>(); }
+
+// The most voxels of one active tile a float triple's tile is expanded into
+// (a triple is merged voxel by voxel; vector grids keep their tiles): a
+// 128^3 tile, the largest below a 4096^3 root tile.
+constexpr openvdb::Index64 TRIPLE_MAX_TILE = openvdb::Index64(128) * 128 * 128;
+
+// The velocity the file's grid (or the triple's three) hold, as a vec3s grid
+// with 0 where inactive: a vec3d grid's vectors rounded to float (a vector
+// beyond float becomes infinite and is refused by scan_velocity).
+Vec3SGrid::Ptr as_vec3s(const GridBase::Ptr& g)
+{
+    if (Vec3SGrid::Ptr s = openvdb::gridPtrCast<Vec3SGrid>(g)) return s;
+    Vec3DGrid::Ptr d = openvdb::gridPtrCast<Vec3DGrid>(g);
+    Vec3SGrid::Ptr out = Vec3SGrid::create(openvdb::Vec3s(0.0f));
+    out->setTransform(d->transform().copy());
+    out->setGridClass(d->getGridClass());
+    Vec3SGrid::Accessor acc = out->getAccessor();
+    for (auto it = d->cbeginValueOn(); it; ++it) {
+        const openvdb::Vec3d x = *it;
+        const openvdb::Vec3s v((float)x[0], (float)x[1], (float)x[2]);
+        if (it.isVoxelValue()) {
+            acc.setValue(it.getCoord(), v);
+        } else {
+            CoordBBox b;
+            it.getBoundingBox(b);
+            out->tree().fill(b, v, true);
+        }
+    }
+    return out;
+}
+
+Vec3SGrid::Ptr merge_triple(const FloatGrid::Ptr c[3], const std::string& where)
+{
+    for (int a = 1; a < 3; ++a)
+        if (!(c[a]->transform() == c[0]->transform()))
+            fail_with(VEIL_ERR_INVALID, where + ": its three float grids have different transforms; a velocity triple "
+                                                "needs one lattice");
+    Vec3SGrid::Ptr out = Vec3SGrid::create(openvdb::Vec3s(0.0f));
+    out->setTransform(c[0]->transform().copy());
+    Vec3SGrid::Accessor acc = out->getAccessor();
+    for (int a = 0; a < 3; ++a)
+        for (auto it = c[a]->cbeginValueOn(); it; ++it) {
+            CoordBBox b;
+            it.getBoundingBox(b);
+            if (b.volume() > TRIPLE_MAX_TILE)
+                fail_with(VEIL_ERR_INVALID, where + ": an active tile of " + std::to_string(b.volume()) +
+                                                " voxels in a float triple (at most a 128^3 tile is merged; store the "
+                                                "velocity as a vec3 grid)");
+            for (auto p = b.begin(); p; ++p) {
+                openvdb::Vec3s v = acc.getValue(*p);
+                v[a] = *it;
+                acc.setValue(*p, v);
+            }
+        }
+    return out;
+}
+
+// The largest |lin v| over the active vectors, refusing one that is not finite.
+void scan_velocity(veil_vdb_velocity& v)
+{
+    double most = 0.0;
+    for (auto it = v.grid->cbeginValueOn(); it; ++it) {
+        const openvdb::Vec3s x = *it;
+        double w[3], n2 = 0.0;
+        for (int r = 0; r < 3; ++r) {
+            w[r] = v.lin[r][0] * x[0] + v.lin[r][1] * x[1] + v.lin[r][2] * x[2];
+            n2 += w[r] * w[r];
+        }
+        if (!std::isfinite(n2)) {
+            const Coord c = it.getCoord();
+            fail_with(VEIL_ERR_INVALID, v.path + ": grid " + quoted(v.name) + ": a velocity at index [" +
+                                            std::to_string(c[0]) + ", " + std::to_string(c[1]) + ", " +
+                                            std::to_string(c[2]) +
+                                            "] is not a finite vector; veil reads finite values only (scene/limits.h)");
+        }
+        most = std::max(most, n2);
+    }
+    v.max = std::sqrt(most);
+}
+
+// What the file holds under `name`: a vec3 grid (returned), or the float
+// triple name.x/.y/.z (its names in triple[]), or nothing (both empty).
+GridBase::Ptr velocity_candidate(const openvdb::GridPtrVec& grids, const std::string& name, std::string triple[3])
+{
+    GridBase::Ptr g = find_grid(grids, name);
+    if (g && is_vector(*g)) return g;
+    int found = 0;
+    for (int a = 0; a < 3; ++a) {
+        GridBase::Ptr c = find_grid(grids, name + "." + "xyz"[a]);
+        if (c && c->isType<FloatGrid>()) triple[a] = c->getName(), ++found;
+    }
+    if (found < 3)
+        for (int a = 0; a < 3; ++a) triple[a].clear();
+    return nullptr;
+}
+
+// ---- advection (veil_vdb_advect_mean) ----------------------------------
+
+// A displacement of more voxels than this is refused before any work: the
+// region grows by it on every side (VEIL_VDB_ADVECT_MAX_VOXELS bounds the
+// result; this keeps the reach an int with room).
+constexpr double ADVECT_MAX_REACH = 1 << 20;
+
+// g's active region grown by `reach` voxels on every side, as active tiles
+// and voxels of value 0 in a grid on g's transform (sparseFill makes
+// tiles where a whole node is covered, so the count is cheap before any
+// voxel exists).
+FloatGrid::Ptr grown_topology(const FloatGrid& g, int reach)
+{
+    FloatGrid::Ptr out = FloatGrid::create(0.0f);
+    out->setTransform(g.transform().copy());
+    for (auto leaf = g.tree().cbeginLeaf(); leaf; ++leaf) {
+        CoordBBox b; // the leaf's active voxels' box (tighter than the node's at the grid's edge)
+        leaf->evalActiveBoundingBox(b, true);
+        if (b.empty()) continue;
+        b.expand(reach);
+        out->tree().sparseFill(b, 0.0f, true);
+    }
+    FloatGrid::ValueOnCIter it = g.cbeginValueOn();
+    it.setMaxDepth(FloatGrid::ValueOnCIter::LEAF_DEPTH - 1); // the active tiles above the leaves
+    for (; it; ++it) {
+        CoordBBox b;
+        it.getBoundingBox(b);
+        b.expand(reach);
+        out->tree().sparseFill(b, 0.0f, true);
+    }
+    return out;
+}
+
+// g with its values below 0 read as 0 (a copy; g when it has none).
+FloatGrid::ConstPtr clamped(const veil_vdb& g)
+{
+    if (g.values.negative == 0) return g.grid;
+    FloatGrid::Ptr c = g.grid->deepCopy();
+    for (auto leaf = c->tree().beginLeaf(); leaf; ++leaf) {
+        float* d = leaf->buffer().data();
+        for (openvdb::Index i = 0; i < FloatGrid::TreeType::LeafNodeType::SIZE; ++i) d[i] = std::max(d[i], 0.0f);
+    }
+    FloatGrid::ValueOnIter it = c->beginValueOn();
+    it.setMaxDepth(FloatGrid::ValueOnIter::LEAF_DEPTH - 1);
+    for (; it; ++it)
+        if (*it < 0.0f) it.setValue(0.0f);
+    return c;
+}
+
+// The velocity at index point y of g (in g's index space: the field's
+// vector, placed, scaled and turned into g's index units: k v).
+struct velocity_at {
+    const veil_vdb_velocity& vel;
+    const openvdb::math::Transform& g_xform; // g's index -> world
+    bool same;                               // the field shares g's transform: sampled in index space
+    double k[3][3];                          // index displacement per unit of raw vector (scale included)
+    Vec3SGrid::ConstAccessor acc;
+
+    openvdb::Vec3d operator()(const openvdb::Vec3d& y)
+    {
+        const openvdb::Vec3d p = same ? y : vel.grid->transform().worldToIndex(g_xform.indexToWorld(y));
+        const openvdb::Vec3s v = vel.staggered ? openvdb::tools::StaggeredBoxSampler::sample(acc, p)
+                                               : openvdb::tools::BoxSampler::sample(acc, p);
+        openvdb::Vec3d d;
+        for (int r = 0; r < 3; ++r) d[r] = k[r][0] * v[0] + k[r][1] * v[1] + k[r][2] * v[2];
+        return d;
+    }
+};
 
 } // namespace
 
@@ -863,6 +1058,214 @@ veil_result veil_vdb_place(veil_vdb* v, const double m[4][4], veil_error* err)
             }
         place(*v->grid, c, v->path.c_str());
     });
+}
+
+veil_result veil_vdb_velocity_open(const char* path, const char* grid_name, veil_vdb_velocity** out, char* chosen,
+                                   size_t chosen_len, veil_error* err)
+{
+    if (out) *out = nullptr;
+    if (!path || !out) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_velocity_open: path and out are required");
+    veil_vdb_velocity* v = nullptr;
+    veil_result r = guarded(err, path, [&] {
+        read_budget budget(path);
+        const bool nano = is_nanovdb(path);
+        openvdb::io::File file(path);
+        openvdb::GridPtrVec metas = file_grids(file, path, nano);
+        static const char* const names[] = VEIL_VDB_VELOCITY_NAMES;
+        std::string name, triple[3];
+        GridBase::Ptr meta;
+        if (grid_name) {
+            name = grid_name;
+            meta = velocity_candidate(metas, name, triple);
+            if (!meta && triple[0].empty()) {
+                GridBase::Ptr g = find_grid(metas, name);
+                if (!g)
+                    fail_with(VEIL_ERR_INVALID, std::string(path) + ": no velocity grid named " + quoted(name) +
+                                                    " (a vec3 grid, or three float grids " + quoted(name + ".x") +
+                                                    ", .y, .z); the file has " + list_grids(metas));
+                fail_with(VEIL_ERR_INVALID, std::string(path) + ": grid " + quoted(name) + " has value type " +
+                                                g->valueType() + ", not a vector: a velocity is a vec3s or vec3d grid, "
+                                                "or three float grids " + quoted(name + ".x") + ", .y, .z");
+            }
+        } else {
+            for (const char* n : names) {
+                name = n;
+                meta = velocity_candidate(metas, name, triple);
+                if (meta || !triple[0].empty()) break;
+            }
+            if (!meta && triple[0].empty())
+                fail_with(VEIL_ERR_INVALID, std::string(path) + ": no velocity grid: looked for 'vel', 'v' and "
+                                                "'velocity' (a vec3 grid, or three float grids NAME.x, .y, .z); the "
+                                                "file has " + list_grids(metas) + "; name one with velocity.grid");
+        }
+        std::unique_ptr<veil_vdb_velocity> vel(new veil_vdb_velocity);
+        vel->path = path;
+        if (meta) {
+            vel->name = name;
+            if (!nano) check_tree(path, name);
+            GridBase::Ptr g = nano ? meta : file.readGrid(name);
+            vel->staggered = g->getGridClass() == openvdb::GRID_STAGGERED;
+            vel->grid = as_vec3s(g);
+        } else {
+            vel->name = name + ".x/.y/.z";
+            FloatGrid::Ptr c[3];
+            for (int a = 0; a < 3; ++a) {
+                if (!nano) check_tree(path, triple[a]);
+                c[a] = openvdb::gridPtrCast<FloatGrid>(nano ? find_grid(metas, triple[a]) : file.readGrid(triple[a]));
+                if (!c[a]) fail_with(VEIL_ERR_IO, std::string(path) + ": grid " + quoted(triple[a]) + ": OpenVDB "
+                                                                         "returned no float grid");
+            }
+            vel->grid = merge_triple(c, std::string(path) + ": velocity " + quoted(vel->name));
+        }
+        if (!nano) file.close();
+        if (!vel->grid->transform().baseMap()->isLinear())
+            fail_with(VEIL_ERR_INVALID, std::string(path) + ": grid " + quoted(vel->name) +
+                                            " has a non-affine transform (" + vel->grid->transform().baseMap()->type() +
+                                            "); veil reads velocity grids whose index-to-world map is affine");
+        zero_inactive(*vel->grid);
+        scan_velocity(*vel);
+        v = vel.release();
+    });
+    if (r != VEIL_OK) return r;
+    copy_name(v->name, chosen, chosen_len);
+    *out = v;
+    return VEIL_OK;
+}
+
+void veil_vdb_velocity_close(veil_vdb_velocity* v) { delete v; }
+
+double veil_vdb_velocity_max(const veil_vdb_velocity* v) { return v ? v->max : 0.0; }
+
+veil_result veil_vdb_velocity_place(veil_vdb_velocity* v, const double m[4][4], veil_error* err)
+{
+    if (!v || !m) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_velocity_place: missing argument");
+    return guarded(err, v->path.c_str(), [&] {
+        double own[4][4], c[4][4], lin[3][3];
+        to_column_matrix(v->grid->transform(), own);
+        for (int r = 0; r < 4; ++r)
+            for (int k = 0; k < 4; ++k) {
+                double s = 0.0;
+                for (int j = 0; j < 4; ++j) s += m[r][j] * own[j][k];
+                c[r][k] = s;
+            }
+        place(*v->grid, c, v->path.c_str());
+        for (int r = 0; r < 3; ++r)
+            for (int k = 0; k < 3; ++k) lin[r][k] = m[r][0] * v->lin[0][k] + m[r][1] * v->lin[1][k] + m[r][2] * v->lin[2][k];
+        std::memcpy(v->lin, lin, sizeof lin);
+        scan_velocity(*v);
+    });
+}
+
+veil_result veil_vdb_advect_mean(veil_vdb* g, const veil_vdb_velocity* vel, const veil_vdb_advect_desc* d,
+                                 veil_vdb_advect_report* report, veil_error* err)
+{
+    if (!g || !vel || !d || !d->times) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_advect_mean: missing argument");
+    if (d->n < 1 || d->n > VEIL_VDB_ADVECT_MAX_TIMES || !(d->scale >= 0.0) || !std::isfinite(d->scale) ||
+        !(d->max_step_voxels > 0.0) || !std::isfinite(d->max_step_voxels))
+        return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_advect_mean: bad description (n %d, scale %g, step %g)", d->n,
+                         d->scale, d->max_step_voxels);
+    double tmax = 0.0;
+    for (int k = 0; k < d->n; ++k) {
+        if (!std::isfinite(d->times[k]))
+            return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_advect_mean: time %d is not finite", k);
+        tmax = std::max(tmax, std::fabs(d->times[k]));
+    }
+    veil_vdb_advect_report rep{};
+    rep.voxels_in = rep.voxels_out = g->active;
+    veil_result r = guarded(err, g->path.c_str(), [&] {
+        const std::string where = g->path + ": grid " + quoted(g->name);
+        const openvdb::math::Transform& xf = g->grid->transform();
+        if (!xf.baseMap()->isLinear())
+            fail_with(VEIL_ERR_INVALID, where + " has a non-affine transform (" + xf.baseMap()->type() + ")");
+        double m[4][4];
+        to_column_matrix(xf, m);
+        double edge = HUGE_VAL; // the smallest voxel edge: a column's length
+        for (int c = 0; c < 3; ++c) edge = std::min(edge, std::sqrt(m[0][c] * m[0][c] + m[1][c] * m[1][c] + m[2][c] * m[2][c]));
+        const double speed = vel->max * d->scale / edge; // voxels per unit of time, at most
+        rep.max_displacement_voxels = speed * tmax;
+        if (!(rep.max_displacement_voxels > 0.0) || g->active == 0) return; // nothing moves: g as it is
+        if (!(rep.max_displacement_voxels <= ADVECT_MAX_REACH))
+            fail_with(VEIL_ERR_LIMIT, where + ": motion blur moves it up to " +
+                                          std::to_string(rep.max_displacement_voxels) + " voxels (at most " +
+                                          std::to_string((long)ADVECT_MAX_REACH) + "): check the velocity's unit and scale");
+        rep.reach = (int)std::ceil(rep.max_displacement_voxels) + 1;
+        FloatGrid::ConstPtr src = d->clamp_negative ? clamped(*g) : FloatGrid::ConstPtr(g->grid);
+        FloatGrid::Ptr out = grown_topology(*src, rep.reach);
+        const openvdb::Index64 voxels = out->activeVoxelCount();
+        if (voxels > VEIL_VDB_ADVECT_MAX_VOXELS)
+            fail_with(VEIL_ERR_LIMIT, where + ": motion blur over its active region grown by " +
+                                          std::to_string(rep.reach) + " voxels (the largest displacement) covers " +
+                                          std::to_string(voxels) + " voxels, over the limit of " +
+                                          std::to_string(VEIL_VDB_ADVECT_MAX_VOXELS) +
+                                          ": shorten the shutter or lower the velocity's scale");
+        out->tree().voxelizeActiveTiles();
+
+        // k: a raw vector v moves an index point by k v per unit of time: (M^-1 lin) scale, M g's 3x3
+        openvdb::Mat3d mc, lc;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) mc(i, j) = m[i][j], lc(i, j) = vel->lin[i][j];
+        const openvdb::Mat3d kc = mc.inverse() * lc;
+        // each side of t = 0, walked outwards: times >= 0 ascending, times < 0 descending
+        std::vector<double> pos, neg;
+        for (int k = 0; k < d->n; ++k) (d->times[k] >= 0.0 ? pos : neg).push_back(d->times[k]);
+        std::sort(pos.begin(), pos.end());
+        std::sort(neg.begin(), neg.end(), [](double a, double b) { return a > b; });
+        const double step_time = d->max_step_voxels / speed; // the longest step (speed > 0 here)
+        const bool same = vel->grid->transform() == xf;
+        const double inv_n = 1.0 / d->n;
+
+        openvdb::tree::LeafManager<FloatGrid::TreeType> leaves(out->tree());
+        leaves.foreach([&](FloatGrid::TreeType::LeafNodeType& leaf, size_t) {
+            FloatGrid::ConstAccessor sacc = src->getConstAccessor(); // one per task: accessors cache
+            velocity_at v_at{*vel, xf, same, {}, vel->grid->getConstAccessor()};
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) v_at.k[i][j] = kc(i, j) * d->scale;
+            for (auto it = leaf.beginValueOn(); it; ++it) {
+                const Coord c = it.getCoord();
+                const openvdb::Vec3d x(c.x(), c.y(), c.z()), vx = v_at(x); // both sides start at x
+                double sum = 0.0;
+                for (const std::vector<double>* side : {&pos, &neg}) {
+                    // backwards along v for h > 0: the first step a midpoint (RK2) one, the next ones
+                    // two-step Adams-Bashforth for steps h after h_prev (second order as well, one
+                    // velocity read a step): y -= h ((1 + q/2) v(y) - (q/2) v(y_prev)), q = h / h_prev
+                    openvdb::Vec3d y = x, v_prev = vx;
+                    double t = 0.0, h_prev = 0.0;
+                    for (double tk : *side) {
+                        const double span = tk - t;
+                        const double steps = std::max(1.0, std::ceil(std::fabs(span) / step_time));
+                        const double h = span / steps;
+                        for (double s = 0; s < steps && h != 0.0; ++s) {
+                            if (h_prev == 0.0) {
+                                y -= h * v_at(y - 0.5 * h * vx);
+                            } else {
+                                const openvdb::Vec3d vy = v_at(y);
+                                const double q = h / h_prev;
+                                y -= h * ((1.0 + 0.5 * q) * vy - (0.5 * q) * v_prev);
+                                v_prev = vy;
+                            }
+                            h_prev = h;
+                        }
+                        t = tk;
+                        sum += openvdb::tools::BoxSampler::sample(sacc, y);
+                    }
+                }
+                const float mean = (float)(sum * inv_n);
+                it.setValue(mean);
+                if (mean == 0.0f) it.setValueOff();
+            }
+        });
+        openvdb::tools::pruneInactive(out->tree());
+        out->setName(g->name);
+        out->setGridClass(openvdb::GRID_FOG_VOLUME);
+        const veil_vdb_values values = scan_values(*out, where);
+        g->grid = out;
+        g->active_box = out->evalActiveVoxelBoundingBox();
+        g->active = out->activeVoxelCount();
+        g->values = values;
+        rep.voxels_out = g->active;
+    });
+    if (report) *report = rep;
+    return r;
 }
 
 } // extern "C"

@@ -155,6 +155,85 @@ typedef struct veil_vdb_census {
 } veil_vdb_census;
 veil_result veil_vdb_census_of(const veil_vdb* v, veil_vdb_census* out, veil_error* err);
 
+/* ---- velocity and motion blur (volume/motion_blur.h decides when) ----
+ *
+ * A velocity field read from a file: a vec3 grid (vec3s or vec3d; a
+ * staggered one, OpenVDB's GRID_STAGGERED MAC layout, is sampled as such),
+ * or three float grids NAME.x, NAME.y, NAME.z on one transform. Vectors
+ * are in the file's world units per unit of time (the source's "unit");
+ * inactive values and the background read as 0, as a density's do.
+ * Ownership as veil_vdb: a copy of the field, read-only once placed. */
+typedef struct veil_vdb_velocity veil_vdb_velocity;
+
+/* The names tried, in this order, when a source names no velocity grid:
+ * each as a vec3 grid, then as the float triple NAME.x/.y/.z. */
+#define VEIL_VDB_VELOCITY_NAMES {"vel", "v", "velocity"}
+
+/* Opens the velocity `grid_name` of `path` (NULL: the first of
+ * VEIL_VDB_VELOCITY_NAMES the file holds) and writes what it read into
+ * chosen ("vel", or "vel.x/.y/.z"). Errors: VEIL_ERR_IO as veil_vdb_open;
+ * VEIL_ERR_INVALID naming the file and grid for a missing grid (listing
+ * the file's grids), a grid that is not a vector (a float grid without
+ * its .x/.y/.z partners, an integer vector...), a triple on different
+ * transforms, a vector that is not finite or a non-affine map. */
+veil_result veil_vdb_velocity_open(const char* path, const char* grid_name, veil_vdb_velocity** out, char* chosen,
+                                   size_t chosen_len, veil_error* err);
+/* Accepts NULL. */
+void veil_vdb_velocity_close(veil_vdb_velocity* v);
+/* Places the field as veil_vdb_place places a grid (m: column vectors,
+ * affine, invertible): its points move by m, and its vectors turn and
+ * stretch with m's 3x3 part (a velocity is a displacement per time). */
+veil_result veil_vdb_velocity_place(veil_vdb_velocity* v, const double m[4][4], veil_error* err);
+/* The largest |vector| of the field, as placed (world units per unit of
+ * time): the trilinear field never exceeds it (a convex mix of corners). */
+double veil_vdb_velocity_max(const veil_vdb_velocity* v);
+
+/* The mean of a grid advected by a steady velocity field over n times:
+ *
+ *   g_b(x) = (1/n) sum_k g(X(x, t_k)),
+ *
+ * X(x, t) the point whose value reaches x after time t: the path from x
+ * traced backwards through the field, dX/ds = -sign(t) scale v(X) for s
+ * in [0, |t|] (semi-Lagrangian; the field is the frame's, held steady over
+ * the times). The path is walked outwards from t = 0 to each side's times
+ * in turn, in steps moving at most max_step_voxels of g's smallest voxel
+ * edge: the first a midpoint (RK2) step, the next ones two-step
+ * Adams-Bashforth (second order too, with one velocity read a step instead
+ * of two); g is sampled trilinearly (BoxSampler) at each t_k, v at the
+ * path's points. A constant field gives exactly g
+ * shifted by -scale v t_k. Only the voxels the paths can reach are made:
+ * g's active voxels and tiles dilated by reach = ceil(max|v| scale
+ * max|t_k| / edge) + 1 voxels (the trilinear support). Runs in parallel
+ * (TBB, one accessor per task). */
+typedef struct veil_vdb_advect_desc {
+    const double* times;    /* n times, in the unit the velocity's vectors are per (a frame, a second) */
+    int n;                  /* 1 .. VEIL_VDB_ADVECT_MAX_TIMES */
+    double scale;           /* world displacement = scale x vector x time; >= 0, finite */
+    double max_step_voxels; /* > 0: the path's steps move at most this many voxels of g */
+    int clamp_negative;     /* 1: g's values below 0 read as 0 first (a density, an emission) */
+} veil_vdb_advect_desc;
+#define VEIL_VDB_ADVECT_MAX_TIMES 1024
+/* The blurred grid's active voxels at most (2^28: 1 GiB of floats, the
+ * size of the dense volume's cap, VEIL_VDB_MAX_DENSE_VOXELS, over 4). */
+#define VEIL_VDB_ADVECT_MAX_VOXELS ((uint64_t)1 << 28)
+
+typedef struct veil_vdb_advect_report {
+    int reach;             /* voxels the active region was dilated by */
+    uint64_t voxels_in;    /* active voxels before (tiles counted by their voxels) */
+    uint64_t voxels_out;   /* active voxels after (non-zero values) */
+    double max_displacement_voxels; /* max|v| scale max|t_k| / edge */
+} veil_vdb_advect_report;
+
+/* Replaces g's values by their blurred mean (same transform, so the same
+ * lattice: native, sparse and dense volumes take it as they take g); g must
+ * not be shared yet (called right after opening and placing, as
+ * veil_vdb_place). With max|v| scale max|t_k| = 0 g is left as it is, bit
+ * for bit. Errors: VEIL_ERR_INVALID for a bad description; VEIL_ERR_LIMIT
+ * when the dilated region would hold more than VEIL_VDB_ADVECT_MAX_VOXELS
+ * (naming the file, the grid and the reach); VEIL_ERR_OOM. */
+veil_result veil_vdb_advect_mean(veil_vdb* g, const veil_vdb_velocity* vel, const veil_vdb_advect_desc* d,
+                                 veil_vdb_advect_report* report, veil_error* err);
+
 /* One grid of a file, as `veil info` shows it. */
 typedef struct veil_vdb_grid_info {
     char* name;            /* owned */

@@ -113,6 +113,7 @@ void veil_scene_free(veil_scene* s)
         free(s->medium.sources[i].vdb.grid);
         free(s->medium.sources[i].vdb.emission_grid);
         free(s->medium.sources[i].vdb.temperature_grid);
+        free(s->medium.sources[i].vdb.velocity_grid);
     }
     free(s->medium.sources);
     for (size_t i = 0; i < s->grid_count; ++i) {

@@ -47,7 +47,28 @@ typedef struct veil_camera {
                          (Blender's shift_x, shift_y); 0: centred on the view axis */
     float clip[2];    /* near and far distance along the view axis (m); the medium outside is not seen
                          (the background still is); far 0: no far plane */
+    /* "shutter": [open, close], frames relative to the frame (open <= close, each within
+     * VEIL_MAX_SHUTTER_FRAMES): vdb sources with a "velocity" are motion-blurred over it
+     * (volume/motion_blur.h). has_shutter 0: no blur (the default) */
+    int has_shutter;
+    float shutter[2];
 } veil_camera;
+
+/* A shutter reaches at most this many frames from its frame: the blur
+ * extrapolates the frame's velocity field as steady flow, which means
+ * nothing over many frames (a film camera's shutter is open at most one
+ * frame, 360 degrees). */
+#define VEIL_MAX_SHUTTER_FRAMES 4.0
+/* The scene's frame rate when it gives none ("fps"), frames per second:
+ * velocities in units per second become displacements with it. */
+#define VEIL_SCENE_DEFAULT_FPS 24.0
+#define VEIL_SCENE_MAX_FPS 1000.0
+
+/* What a vdb source's velocity grid holds per unit of time. */
+typedef enum veil_velocity_unit {
+    VEIL_VELOCITY_PER_SECOND = 0, /* world units per second (OpenVDB's, Houdini's "vel") */
+    VEIL_VELOCITY_PER_FRAME = 1   /* world units per frame */
+} veil_velocity_unit;
 
 typedef enum veil_phase_type { VEIL_PHASE_ISOTROPIC = 0, VEIL_PHASE_HG = 1 } veil_phase_type;
 
@@ -95,6 +116,14 @@ typedef struct veil_vdb_source {
      * grids alike. has_transform 0: the grids' own maps */
     int has_transform;
     double transform[4][4];
+    /* "velocity": {"grid", "unit", "scale"}: the grid the density moves with, for motion
+     * blur under the camera's shutter (volume/motion_blur.h); has_velocity 0: none.
+     * velocity_grid NULL: the first of "vel", "v", "velocity" (a vec3 grid, or three float
+     * grids NAME.x, NAME.y, NAME.z) the file holds */
+    int has_velocity;
+    char* velocity_grid;   /* owned */
+    int velocity_unit;     /* veil_velocity_unit */
+    float velocity_scale;  /* multiplies the vectors; default 1 */
 } veil_vdb_source;
 
 /* Analytic exponential (height) fog ({"type":"exponential", ...}):
@@ -274,6 +303,7 @@ typedef struct veil_scene {
     veil_multiple multiple;
     veil_quality quality; /* "quality": UNSET when absent */
     int deep_samples;     /* "deep": {"samples"}: a deep image's cap (render/deep.h); 0 when absent */
+    double fps;           /* "fps": frames per second, (0, VEIL_SCENE_MAX_FPS]; 0 read as the default */
     veil_scene_grid* grids; /* owned; grid_count of them */
     size_t grid_count;
 } veil_scene;

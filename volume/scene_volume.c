@@ -11,6 +11,7 @@
 #include "../core/progress.h"
 #include "../scene/limits.h"
 #include "blackbody.h"
+#include "motion_blur.h"
 #include "sparse.h"
 #include "vdb_volume.h"
 
@@ -69,7 +70,8 @@ static veil_result open_grid(const veil_scene* s, const veil_source* src, size_t
  * grows [lo, hi] by its support. The source's density grid is the last
  * opened (vdbs[vdb_count - 1]). */
 static veil_result open_emission(const veil_scene* s, veil_scene_volume* v, const veil_source* src, size_t i,
-                                 int temperature, float lo[3], float hi[3], int* any, veil_error* err)
+                                 int temperature, const veil_motion_blur* mb, float lo[3], float hi[3], int* any,
+                                 veil_error* err)
 {
     veil_vdb* e = NULL;
     veil_error inner = {{0}};
@@ -80,6 +82,11 @@ static veil_result open_emission(const veil_scene* s, veil_scene_volume* v, cons
     veil_emission_source* es = &v->emission[v->emission_count++];
     memset(es, 0, sizeof *es);
     es->grid = e;
+    /* blurred with the density's velocity and times (a temperature below 0 is kept, as it is read) */
+    r = veil_motion_blur_apply(mb, e, !temperature, NULL, &inner);
+    if (r != VEIL_OK)
+        return veil_fail(err, r, "medium.sources[%zu].%s.grid: motion blur: %.1900s", i,
+                         temperature ? "temperature" : "emission", inner.msg);
     es->temperature = temperature;
     es->density = v->vdb_count - 1;
     es->t_scale = src->vdb.temperature_scale, es->t_offset = src->vdb.temperature_offset;
@@ -104,6 +111,18 @@ static veil_result open_emission(const veil_scene* s, veil_scene_volume* v, cons
     return r;
 }
 
+/* Notes in v->motion what source i's motion blur did, for --stats and
+ * --explain (appended to v->resolution once the grid is chosen). */
+static void note_blur(veil_scene_volume* v, size_t i, const veil_motion_blur* mb, const veil_vdb_advect_report* rep)
+{
+    char note[256]; /* (what fits in v->motion is kept) */
+    snprintf(note, sizeof note, "; source %zu blurred by '%.64s': %d samples, %.3g voxels over the shutter%s", i,
+             mb->velocity_name, mb->samples, mb->displacement,
+             mb->displacement > VEIL_BLUR_MAX_SAMPLES ? " (capped)" : rep->reach ? "" : " (no motion)");
+    size_t len = strlen(v->motion), n = strlen(note);
+    if (len + n < sizeof v->motion) memcpy(v->motion + len, note, n + 1);
+}
+
 /* Opens source i's grid and grows [lo, hi] by its support. */
 static veil_result open_vdb(const veil_scene* s, veil_scene_volume* v, const veil_source* src, size_t i, float lo[3],
                             float hi[3], int* any, veil_error* err)
@@ -124,8 +143,25 @@ static veil_result open_vdb(const veil_scene* s, veil_scene_volume* v, const vei
     if (r != VEIL_OK) return r;
     v->vdbs[v->vdb_count] = vdb;
     v->vdb_scale[v->vdb_count++] = src->vdb.density_scale;
+    /* motion blur: the grids replaced by their means over the shutter before anything reads them */
+    veil_motion_blur mb;
+    veil_vdb_advect_report blur = {0};
+    r = veil_motion_blur_open(s, src, i, vdb, &mb, err);
+    if (r != VEIL_OK) return r;
+    r = veil_motion_blur_apply(&mb, vdb, 1, &blur, &inner);
+    if (r != VEIL_OK) {
+        veil_motion_blur_close(&mb);
+        return veil_fail(err, r, "medium.sources[%zu]: motion blur: %.1900s", i, inner.msg);
+    }
+    if (mb.velocity) {
+        note_blur(v, i, &mb, &blur);
+        snprintf(v->velocity_read[v->vdb_count - 1], sizeof v->velocity_read[0], "%s", mb.velocity_name);
+    }
     r = veil_vdb_check_values(vdb, VEIL_VALUES_DENSITY, src->vdb.density_scale, 0.0, &inner);
-    if (r != VEIL_OK) return veil_fail(err, r, "medium.sources[%zu]: %.1900s", i, inner.msg);
+    if (r != VEIL_OK) {
+        veil_motion_blur_close(&mb);
+        return veil_fail(err, r, "medium.sources[%zu]: %.1900s", i, inner.msg);
+    }
     int ilo[3], ihi[3];
     size_t active = 0;
     r = veil_vdb_index_bbox(vdb, ilo, ihi, &active);
@@ -135,9 +171,9 @@ static veil_result open_vdb(const veil_scene* s, veil_scene_volume* v, const vei
         if (r == VEIL_OK) grow(lo, hi, any, a, b);
     }
     v->vdb_voxels += active;
-    if (r != VEIL_OK) return r;
-    if (src->vdb.emission_grid) r = open_emission(s, v, src, i, 0, lo, hi, any, err);
-    if (r == VEIL_OK && src->vdb.temperature_grid) r = open_emission(s, v, src, i, 1, lo, hi, any, err);
+    if (r == VEIL_OK && src->vdb.emission_grid) r = open_emission(s, v, src, i, 0, &mb, lo, hi, any, err);
+    if (r == VEIL_OK && src->vdb.temperature_grid) r = open_emission(s, v, src, i, 1, &mb, lo, hi, any, err);
+    veil_motion_blur_close(&mb);
     return r;
 }
 
@@ -263,6 +299,17 @@ uint64_t veil_scene_volume_key(const veil_scene* s)
             k = veil_hash_bytes(k, &src->vdb.temperature_scale, sizeof src->vdb.temperature_scale);
             k = veil_hash_bytes(k, &src->vdb.temperature_offset, sizeof src->vdb.temperature_offset);
             k = veil_hash_bytes(k, &src->vdb.temperature_intensity, sizeof src->vdb.temperature_intensity);
+            /* motion blur: the velocity, the shutter and the frame rate make the grids (only when asked for,
+             * so that a scene without blur keys as before) */
+            if (src->vdb.has_velocity && s->camera.has_shutter) {
+                const char* vg = src->vdb.velocity_grid ? src->vdb.velocity_grid : "";
+                const double fps = s->fps > 0.0 ? s->fps : VEIL_SCENE_DEFAULT_FPS;
+                k = veil_hash_bytes(k, vg, strlen(vg) + 1);
+                k = veil_hash_bytes(k, &src->vdb.velocity_unit, sizeof src->vdb.velocity_unit);
+                k = veil_hash_bytes(k, &src->vdb.velocity_scale, sizeof src->vdb.velocity_scale);
+                k = veil_hash_bytes(k, s->camera.shutter, sizeof s->camera.shutter);
+                k = veil_hash_bytes(k, &fps, sizeof fps);
+            }
             k = veil_hash_bytes(k, s->medium.sigma_a, sizeof s->medium.sigma_a); /* Kirchhoff's k */
             k = veil_hash_bytes(k, &s->multiple.emission_lights, sizeof s->multiple.emission_lights);
         }
@@ -446,6 +493,12 @@ static void note_unread(veil_scene_volume* v, int i)
             size_t k = strlen(name);
             used |= v->emission[e].density == i && n > k + 1 && strncmp(p, name, k) == 0 && p[k] == ' ';
         }
+        /* the velocity of a blurred source: "vel", or each of "vel.x/.y/.z" */
+        const char* vel = v->velocity_read[i];
+        const char* dot = strstr(vel, ".x/.y/.z");
+        size_t vk = dot ? (size_t)(dot - vel) : strlen(vel);
+        used |= vk > 0 && n > vk + 1 && strncmp(p, vel, vk) == 0 &&
+                (dot ? p[vk] == '.' && strchr("xyz", p[vk + 1]) && p[vk + 2] == ' ' : p[vk] == ' ');
         size_t len = strlen(unread);
         if (!used && len + n + 3 < sizeof unread) snprintf(unread + len, sizeof unread - len, "%s%.*s", len ? ", " : "", (int)n, p);
         p += n;
@@ -495,11 +548,17 @@ veil_result veil_scene_volume_open(const veil_scene* s, veil_scene_volume* out, 
         if (i < v.vdb_count && !(v.vdb_scale[i] > 0.0f)) continue;
         r = veil_vdb_plan_resample(i < v.vdb_count ? v.vdbs[i] : v.emission[i - v.vdb_count].grid, &v.grid, &plan, err);
     }
+    /* what the motion blur did, first: the notes below may fill the line */
+    if (r == VEIL_OK && v.motion[0]) {
+        size_t len = strlen(v.resolution);
+        snprintf(v.resolution + len, sizeof v.resolution - len, "%s", v.motion);
+    }
     /* say which grids of the files were not read (velocity and the like) */
     for (int i = 0; i < v.vdb_count && r == VEIL_OK; ++i) note_negative(&v, v.vdbs[i]);
     for (int i = 0; i < v.emission_count && r == VEIL_OK; ++i)
         if (!v.emission[i].temperature) note_negative(&v, v.emission[i].grid);
     for (int i = 0; i < v.vdb_count && r == VEIL_OK; ++i) note_unread(&v, i);
+
     if (r != VEIL_OK) {
         veil_scene_volume_close(&v);
         return r;

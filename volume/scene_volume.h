@@ -49,6 +49,8 @@ typedef struct veil_scene_volume {
     /* How the grid was chosen, for --stats: "native: ..." or "resampled: ...",
      * and the files' grids that were not read ("; read 'density', not: vel (vec3s)") */
     char resolution[320];
+    char velocity_read[VEIL_MAX_VDB_SOURCES][96]; /* each vdb's velocity grid when blurred ("": none) */
+    char motion[160]; /* the sources' motion blur, "; source 0 blurred by 'vel': 4 samples, ..." ("": none) */
     /* Emission ("emission" and "temperature" of vdb sources); the grid
      * above covers their supports too. */
     veil_emission_source emission[2 * VEIL_MAX_VDB_SOURCES];
@@ -88,7 +90,9 @@ void veil_emission_eps(const veil_scene_volume* v, const veil_emission_source* e
 /* The key of the volume a scene's sources make, from their descriptions
  * alone: the resolution, explicit particles, the random generators'
  * parameters, each VDB file's identity (path, size, modification time,
- * inode; never its bytes), grid name, scale and level-set mode. Nothing is
+ * inode; never its bytes), grid name, scale and level-set mode, and for a
+ * source that is motion-blurred (volume/motion_blur.h) its velocity's grid,
+ * unit and scale with the camera's shutter and the scene's fps. Nothing is
  * opened, so a cached volume is recognised in microseconds whatever the
  * files' sizes. Analytic fog is not part of it (never voxelised). */
 uint64_t veil_scene_volume_key(const veil_scene* s);

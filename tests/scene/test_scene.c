@@ -342,8 +342,8 @@ static const bad_case BAD[] = {
     {"{'camera':{'position':'here','look_at':[0,0,0]}," MED "}", VEIL_ERR_INVALID, "camera.position",
      "expected an array of 3 numbers, each in [-1e15, 1e15] (m: scene/limits.h), got a string (\"here\")"},
     {"{'camera':{'position':[0,0,1],'look_at':[0,0,0],'fov':40}," MED "}", VEIL_ERR_INVALID, "camera.fov",
-     "unknown key (expected one of: position, look_at, up, fov_y_deg, fov_deg, sensor_fit, shift, clip, width, "
-     "height)"},
+     "unknown key (expected one of: position, look_at, up, fov_y_deg, fov_deg, sensor_fit, shift, clip, shutter, "
+     "width, height)"},
     /* the sensor fit, the shift and the clip planes (issue 25) */
     {"{'camera':{'position':[0,0,1],'look_at':[0,0,0],'sensor_fit':'diagonal'}," MED "}", VEIL_ERR_INVALID,
      "camera.sensor_fit", "expected one of \"vertical\", \"horizontal\", \"auto\", got a string (\"diagonal\")"},
@@ -563,7 +563,7 @@ static void test_exact_messages(void)
                         "(a number of degrees in (0, 180])") == 0, "%s", e.msg);
     parse("scene.json", "{'camera':{'position':[0,0,1],'look_at':[0,0,0],'fov':40}," MED "}", &s, &e);
     CHECK(strcmp(e.msg, "scene.json: camera.fov: unknown key (expected one of: position, look_at, up, "
-                        "fov_y_deg, fov_deg, sensor_fit, shift, clip, width, height)") == 0, "%s", e.msg);
+                        "fov_y_deg, fov_deg, sensor_fit, shift, clip, shutter, width, height)") == 0, "%s", e.msg);
     parse("demo.json", "{'camera':{'look_at':[0,0,0]}," MED "}", &s, &e);
     CHECK(strcmp(e.msg, "demo.json: camera.position: missing required field (an array of 3 numbers, each in [-1e15, 1e15] (m: scene/limits.h))") == 0,
           "%s", e.msg);

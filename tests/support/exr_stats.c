@@ -8,6 +8,9 @@
  *                                 R, G, B >= 0 and A in [0, 1] (io/image.h:
  *                                 linear radiance, A = 1 - mean transmittance)
  *   exr_stats --png FILE.png W H  the PNG decodes (libpng) to W x H pixels
+ *   exr_stats --extent FILE.exr T the box of the pixels whose A is above T,
+ *                                 "extent x0 x1 y0 y1 n" (columns, rows, inclusive; y
+ *                                 0 the top row; n the pixels), or "extent none"
  *   exr_stats --write-bad KIND FILE.exr
  *                                 writes a 4x3 R, G, B, A EXR that --rgba
  *                                 accepts, except for one value by KIND:
@@ -121,6 +124,29 @@ static int png_check(const char* path, int w, int h)
     return !ok;
 }
 
+static int extent(const char* path, double threshold)
+{
+    int w = 0, h = 0, box[4] = {0, -1, 0, -1};
+    float* a = NULL;
+    veil_error err = {0};
+    if (veil_read_exr_channel(path, "A", &w, &h, &a, &err) != VEIL_OK) {
+        fprintf(stderr, "exr_stats: %s\n", err.msg);
+        return 2;
+    }
+    size_t n = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            if (a[(size_t)y * (size_t)w + (size_t)x] > threshold) {
+                if (!n++) box[0] = box[1] = x, box[2] = box[3] = y;
+                box[0] = x < box[0] ? x : box[0], box[1] = x > box[1] ? x : box[1];
+                box[2] = y < box[2] ? y : box[2], box[3] = y > box[3] ? y : box[3];
+            }
+    free(a);
+    if (n) printf("extent %d %d %d %d %zu\n", box[0], box[1], box[2], box[3], n);
+    else printf("extent none\n");
+    return 0;
+}
+
 static int write_bad(const char* kind, const char* path)
 {
     enum { W = 4, H = 3, N = W * H };
@@ -150,6 +176,8 @@ int main(int argc, char** argv)
     if (argc == 3 && !strcmp(argv[1], "--rgba")) return exr_check(argv[2], 1);
     if (argc == 5 && !strcmp(argv[1], "--png")) return png_check(argv[2], atoi(argv[3]), atoi(argv[4]));
     if (argc == 4 && !strcmp(argv[1], "--write-bad")) return write_bad(argv[2], argv[3]);
-    fprintf(stderr, "usage: exr_stats [--rgba] FILE.exr | --png FILE.png W H | --write-bad KIND FILE.exr\n");
+    if (argc == 4 && !strcmp(argv[1], "--extent")) return extent(argv[2], atof(argv[3]));
+    fprintf(stderr, "usage: exr_stats [--rgba] FILE.exr | --png FILE.png W H | --write-bad KIND FILE.exr | "
+                    "--extent FILE.exr T\n");
     return 2;
 }

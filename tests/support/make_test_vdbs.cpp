@@ -7,6 +7,8 @@
 //   make_test_vdbs --plume FILE  only the plume, at the size of big_plume.vdb, into FILE
 //   make_test_vdbs --plume-faded FILE  the same, faded out at its bottom and top (bench/peers.py)
 //   make_test_vdbs --pyro FILE   the base-size plume with a "temperature" grid (0..1), into FILE
+//   make_test_vdbs --smoke-vel FILE  a 128^3 plume with a swirling "vel" (motion blur's timing:
+//                                docs/performance.md)
 //   make_test_vdbs --pair A B    two overlapping plumes for a two-source scene (bench/vdb_import.py):
 //                                A the base plume (voxel 0.02 m), B a smaller one (voxel 0.03 m,
 //                                moved by (0.35, 0.5, 0.1) m: off A's lattice)
@@ -40,6 +42,7 @@
 //   half_mismatch.vdb, nano_size.nvdb, nano_child.nvdb: one small grid each,
 //                        with one claim of its tree made absurd (tree_files below)
 //   values.vdb           grids whose values the pipeline cannot carry (value_files below)
+//   blur.vdb, moving.0001.vdb .. moving.0003.vdb: motion blur's (blur_files below)
 //   values_nan.nvdb      its "density_nan" grid written by NanoVDB
 //
 // The values that tests/io/test_vdb.c recomputes (the linear field, the two
@@ -268,6 +271,82 @@ void value_files()
     nanovdb::io::writeGrid(path("values_nan.nvdb"), nanovdb::openToNanoVDB(*density_nan));
 }
 
+// Motion blur's files (tests/volume/test_motion_blur.c, tests/render/test_motion_blur.c,
+// tests/cli/turntable_motion_blur.sh), voxel 0.125 m (exact in binary, so that the tests'
+// shifts are whole voxels exactly):
+//   blur.vdb: "density" a Gaussian puff (peak 1, sigma 3 voxels, cut at 3 sigma) at index
+//     (0, 0, 0); "anchor" two active voxels of value 0 at index (-16, -16, -16) and (16, 16,
+//     16) (a second source that fixes the volume's box whatever the puff's shift); "vel" the
+//     constant vector (1, 0, 0) (m per unit of time) on the active box [-40, 40]^3, "vel_d"
+//     the same as vec3d, "vel_zero" (0, 0, 0) there, "wind.x", "wind.y", "wind.z" the same
+//     field as three float grids (1, 0, 0); "speed" a float grid (not a vector); "swirl" a
+//     rotation about the z axis through world (-1, 0, 0) at 1 rad per unit of time, v = (-y,
+//     x + 1, 0) at world (x, y, z), on [-40, 40]^3 (linear, so its trilinear field is exact)
+//   moving.000F.vdb (F = 1, 2, 3): "density" the puff at index (4 (F - 2), 0, 0), "vel"
+//     (12, 0, 0) m/s on [-40, 40]^3: at 24 fps the puff's own motion, 4 voxels a frame
+FloatGrid::Ptr blur_puff(int x)
+{
+    FloatGrid::Ptr g = float_grid("density", 0.125);
+    puff(*g, Coord(x, 0, 0), 1.0f, 3.0);
+    return g;
+}
+
+void blur_files()
+{
+    const openvdb::CoordBBox box(Coord(-40), Coord(40));
+    auto vec = [&](const char* name, float x) {
+        openvdb::Vec3SGrid::Ptr v = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+        v->setName(name);
+        v->setTransform(openvdb::math::Transform::createLinearTransform(0.125));
+        v->tree().fill(box, openvdb::Vec3s(x, 0.0f, 0.0f), true);
+        return v;
+    };
+    openvdb::Vec3DGrid::Ptr vd = openvdb::Vec3DGrid::create(openvdb::Vec3d(0.0));
+    vd->setName("vel_d");
+    vd->setTransform(openvdb::math::Transform::createLinearTransform(0.125));
+    vd->tree().fill(box, openvdb::Vec3d(1.0, 0.0, 0.0), true);
+    FloatGrid::Ptr anchor = float_grid("anchor", 0.125), speed = float_grid("speed", 0.125);
+    anchor->tree().setValueOn(Coord(-16), 0.0f);
+    anchor->tree().setValueOn(Coord(16), 0.0f);
+    speed->tree().setValue(Coord(0), 1.0f);
+    openvdb::Vec3SGrid::Ptr swirl = vec("swirl", 0.0f);
+    for (auto p = box.begin(); p; ++p)
+        swirl->tree().setValue(*p, openvdb::Vec3s(-0.125f * (float)(*p).y(), 0.125f * (float)(*p).x() + 1.0f, 0.0f));
+    openvdb::GridPtrVec grids = {blur_puff(0), anchor, vec("vel", 1.0f), vd, vec("vel_zero", 0.0f), speed, swirl};
+    for (int a = 0; a < 3; ++a) {
+        FloatGrid::Ptr w = float_grid((std::string("wind.") + "xyz"[a]).c_str(), 0.125);
+        w->tree().fill(box, a == 0 ? 1.0f : 0.0f, true);
+        grids.push_back(w);
+    }
+    write("blur.vdb", grids);
+    for (int f = 1; f <= 3; ++f) {
+        char name[32];
+        std::snprintf(name, sizeof name, "moving.%04d.vdb", f);
+        write(name, {blur_puff(4 * (f - 2)), vec("vel", 12.0f)});
+    }
+}
+
+// A smoke-like grid with velocity for motion blur's timing: the plume at 1.28 times
+// the base size (128 voxels tall, voxel 0.02 m) and "vel" on its active voxels
+// dilated by 8, a swirl about the plume's axis plus an updraft (m/s): (-w z, u, w x)
+// with w = 6 rad/s and u = 1.5 m/s, up to about 3 m/s at the rim.
+openvdb::GridPtrVec smoke_with_velocity()
+{
+    FloatGrid::Ptr d = plume(1.28);
+    openvdb::Vec3SGrid::Ptr v = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+    v->setName("vel");
+    v->setTransform(d->transform().copy());
+    openvdb::CoordBBox box = d->evalActiveVoxelBoundingBox();
+    box.expand(8);
+    const double w = 6.0, u = 1.5, h = 0.02;
+    openvdb::Vec3SGrid::Accessor acc = v->getAccessor();
+    for (auto p = box.begin(); p; ++p) {
+        const double x = (*p).x() * h, z = (*p).z() * h;
+        acc.setValue(*p, openvdb::Vec3s((float)(-w * z), (float)u, (float)(w * x)));
+    }
+    return {d, v};
+}
+
 void make_all(bool big)
 {
     const float sphere_voxel = 0.05f, sphere_radius = 1.0f; // 20 voxels
@@ -361,6 +440,7 @@ void make_all(bool big)
 
     sparse_pair();
     value_files();
+    blur_files();
 
     write("smoke_plume.vdb", {plume(1.0)});
     if (big) write("big_plume.vdb", {plume(2.2)});
@@ -603,6 +683,20 @@ int main(int argc, char** argv)
         std::printf("wrote %s\n", argv[2]);
         return 0;
     }
+    if (argc == 3 && std::strcmp(argv[1], "--smoke-vel") == 0) {
+        std::filesystem::path file(argv[2]);
+        g_dir = file.has_parent_path() ? file.parent_path().string() : std::string(".");
+        try {
+            std::filesystem::create_directories(g_dir);
+            openvdb::initialize();
+            write(file.filename().string().c_str(), smoke_with_velocity());
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "make_test_vdbs: %s\n", e.what());
+            return 1;
+        }
+        std::printf("wrote %s\n", argv[2]);
+        return 0;
+    }
     if (argc == 4 && std::strcmp(argv[1], "--pair") == 0) {
         try {
             openvdb::initialize();
@@ -641,7 +735,8 @@ int main(int argc, char** argv)
         return 0;
     }
     if (argc < 2 || argc > 3 || (argc == 3 && std::strcmp(argv[2], "--big") != 0)) {
-        std::fprintf(stderr, "usage: %s DIR [--big] | --plume FILE | --plume-faded FILE | --pyro FILE | --pair A B | --odd-names FILE\n", argv[0]);
+        std::fprintf(stderr, "usage: %s DIR [--big] | --plume FILE | --plume-faded FILE | --pyro FILE | --smoke-vel FILE | --pair A B | "
+                             "--odd-names FILE\n", argv[0]);
         return 2;
     }
     g_dir = argv[1];
