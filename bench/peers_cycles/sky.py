@@ -54,38 +54,11 @@ def main():
     # The sky seen straight through the medium, T sky, is the same in both (the reference's T is exact,
     # Cycles' an unbiased estimate of it) and would swamp the comparison (most pixels are sky): both
     # images less the exact T sky leave the light the medium scattered, compared where the medium is
-    # (T < 0.99). The reference's grey medium has T = 1 - A in every channel.
+    # (T < 0.99): environment.py's measure, with the sky as a constant environment.
     import numpy as np
-    import OpenImageIO as oiio
-
-    def read(path):
-        buf = oiio.ImageBuf(path)
-        return list(buf.spec().channelnames), buf.get_pixels(oiio.FLOAT)
-
-    rn, rp = read(ref)
-    cn, cp = read(cyc)
-    rgb = [rn.index(c) for c in "RGB"]
-    T = 1.0 - rp[..., rn.index("A")]
-    sky_t = T[..., None] * np.array(sky, dtype=np.float64)
-    r_sc = rp[..., rgb] - sky_t
-    c_sc = cp[..., [cn.index(c) for c in "RGB"]] - sky_t
-    se = rp[..., [rn.index("stderr." + c) for c in "RGB"]]
-    se = np.abs(se)  # a negative value marks a bound (reference/pathtracer.h); its size is what counts here
-    mask = T < 0.99
-    n = int(mask.sum())
-    r_mean, c_mean = float(r_sc[mask].mean()), float(c_sc[mask].mean())
-    r_mean_se = float(np.sqrt((se[mask] ** 2).sum()) / se[mask].size)
-    bias = c_mean / r_mean - 1.0
-    bias_se = (c_mean / r_mean) * r_mean_se / r_mean
-
-    def blocks(x, b):
-        hh, ww = x.shape[0] // b * b, x.shape[1] // b * b
-        return x[:hh, :ww].reshape(hh // b, b, ww // b, b, -1).mean(axis=(1, 3))
-
-    mb = blocks(mask[..., None].astype(np.float64), 4)[..., 0] > 0.999
-    rb, cb = blocks(r_sc, 4), blocks(c_sc, 4)
-    rel4 = float(np.sqrt(((cb - rb)[mb] ** 2).mean()) / np.abs(rb[mb]).mean()) if mb.any() else float("nan")
-    noise4 = float(np.sqrt((blocks(se ** 2, 4)[mb] / 16.0).mean()) / np.abs(rb[mb]).mean()) if mb.any() else float("nan")
+    from environment import cycles_vs_reference
+    n, bias, bias_se, rel4, noise4 = cycles_vs_reference(
+        ref, cyc, lambda d: np.broadcast_to(np.array(sky, dtype=np.float64), d.shape), sc, w, h)
     lines = ["The shared smoke under a constant sky %s (no other light), %dx%d, every order: `veil reference "
              "--background lights` at %d spp (%.1f s) against Blender 3.4 Cycles' world lighting at %d spp (%.1f s "
              "wall). `/usr/bin/python3 bench/peers_cycles/sky.py --size %s --ref-spp %d --cycles-spp %d` (%s). "
