@@ -252,6 +252,31 @@ def _pick_density(vol, wanted, where):
     raise ExportError("%s: no float grid to read as density (grids: %s)" % (where, ', '.join(names) or 'none'))
 
 
+def _velocity(vol, orig, where, warnings):
+    """The volume's velocity as veil's {"grid", "unit", "scale"} (Blender's Velocity panel: a vector grid, or
+    three float grids, which veil reads as NAME.x, NAME.y, NAME.z), or None with a warning when the file has
+    no such grid: Cycles then blurs nothing either."""
+    grids = {g.name: g.data_type for g in vol.grids}
+    name = orig.velocity_grid.strip()
+    found = None
+    if name in grids and grids[name].startswith('VECTOR'):
+        found = name
+    else:
+        xyz = [orig.velocity_x_grid.strip(), orig.velocity_y_grid.strip(), orig.velocity_z_grid.strip()]
+        stem = xyz[0][:-2] if xyz[0].endswith('.x') else None
+        if stem and xyz == [stem + '.x', stem + '.y', stem + '.z'] and all(n in grids for n in xyz):
+            found = stem
+        elif all(xyz) and all(n in grids for n in xyz):
+            warnings.append("%s: velocity grids '%s', '%s', '%s': veil reads three float grids named NAME.x, NAME.y, "
+                            "NAME.z: not motion-blurred" % ((where,) + tuple(xyz)))
+            return None
+    if found is None:
+        warnings.append("%s: motion blur is on but the file has no velocity grid%s: not motion-blurred"
+                        % (where, " '%s'" % name if name else ""))
+        return None
+    return {'grid': found, 'unit': orig.velocity_unit.lower(), 'scale': orig.velocity_scale}
+
+
 def export_volume(ob, matrix, depsgraph, settings, warnings, sequences_as_pattern):
     """A "vdb" source for the Volume object `ob` (evaluated) placed by `matrix`, or None when the
     volume has no file at this frame (a clipped sequence)."""
@@ -320,6 +345,10 @@ def export_volume(ob, matrix, depsgraph, settings, warnings, sequences_as_patter
         if vs.use_temperature_intensity:
             temp['intensity'] = vs.temperature_intensity
         src['temperature'] = temp
+    if depsgraph.scene.render.use_motion_blur:
+        vel = _velocity(vol, orig, where, warnings)
+        if vel is not None:
+            src['velocity'] = vel
     return src
 
 
@@ -351,6 +380,15 @@ def export_scene(depsgraph, *, sequences_as_pattern=False, size=None, render_vis
     width, height = size if size is not None else render_size(scene)
     cam_obj = scene.camera.evaluated_get(depsgraph) if scene.camera is not None else None
     out = {'camera': export_camera(scene, cam_obj, width, height, warnings)}
+    rd = scene.render
+    if rd.use_motion_blur:
+        # Blender's shutter is a fraction of a frame placed at the frame's start, centre or end (Cycles'
+        # motion_blur_position); veil's is [open, close] in frames around the frame, and fps converts a
+        # velocity per second
+        s_len = rd.motion_blur_shutter
+        pos = getattr(scene.cycles, 'motion_blur_position', 'CENTER') if hasattr(scene, 'cycles') else 'CENTER'
+        out['camera']['shutter'] = {'START': [0.0, s_len], 'END': [-s_len, 0.0]}.get(pos, [-0.5 * s_len, 0.5 * s_len])
+        out['fps'] = rd.fps / rd.fps_base
     medium = export_medium(settings)
     sources, lights = [], []
     skipped = set()

@@ -211,4 +211,44 @@ for on in (True, False):
     err = max(abs(t[i][j] - want[i][j]) for i in range(4) for j in range(4))
     check(err < 1e-6 and src['file'] == path and src['grid'] == 'density',
           "volume transform = matrix_world%s (max difference %.2g)" % (" x half a voxel" if on else "", err))
+
+# --- motion blur: Blender's shutter and the volume's velocity -------------------------------------
+# Render > Motion Blur on, shutter 0.5 of a frame centred on it: veil's camera.shutter [-0.25, 0.25], fps
+# the scene's; the Volume's Velocity panel (grid 'velocity', per frame, scale 2) as the source's velocity.
+# A file with the vector grid, then one without (a warning, no velocity), then START: [0, 0.5].
+import numpy as np  # noqa: E402
+import pyopenvdb as vdb  # noqa: E402
+vpath = os.path.join(work, "moving.vdb")
+dens = vdb.FloatGrid()
+dens.name = "density"
+dens.copyFromArray(np.ones((4, 4, 4), dtype=np.float32))
+vel = vdb.Vec3SGrid()
+vel.name = "velocity"
+vel.copyFromArray(np.ones((4, 4, 4, 3), dtype=np.float32))
+vdb.write(vpath, grids=[dens, vel])
+ob.data.filepath = vpath
+ob.data.grids.load()
+ob.data.velocity_unit, ob.data.velocity_scale = 'FRAME', 2.0
+sc.render.use_motion_blur, sc.render.motion_blur_shutter = True, 0.5
+sc.render.fps, sc.render.fps_base = 30, 1.001
+sc.cycles.motion_blur_position = 'CENTER'
+bpy.context.view_layer.update()
+data, warnings = export.export_scene(bpy.context.evaluated_depsgraph_get())
+(src,) = data['medium']['sources']
+check(src.get('velocity') == {'grid': 'velocity', 'unit': 'frame', 'scale': 2.0} and
+      data['camera'].get('shutter') == [-0.25, 0.25] and data.get('fps') == sc.render.fps / sc.render.fps_base,
+      "motion blur: shutter %s, fps %s, velocity %s" % (data['camera'].get('shutter'), data.get('fps'), src.get('velocity')))
+sc.cycles.motion_blur_position = 'START'
+data, _ = export.export_scene(bpy.context.evaluated_depsgraph_get())
+check(data['camera'].get('shutter') == [0.0, 0.5], "motion blur from the frame's start: %s" % data['camera'].get('shutter'))
+ob.data.filepath = path  # the sphere: no velocity grid
+ob.data.grids.load()
+bpy.context.view_layer.update()
+data, warnings = export.export_scene(bpy.context.evaluated_depsgraph_get())
+(src,) = data['medium']['sources']
+check('velocity' not in src and any("no velocity grid" in w for w in warnings),
+      "no velocity grid: none exported, with a warning (%s)" % [w for w in warnings if "velocity" in w])
+sc.render.use_motion_blur = False
+data, _ = export.export_scene(bpy.context.evaluated_depsgraph_get())
+check('shutter' not in data['camera'] and 'fps' not in data, "motion blur off: no shutter")
 common.finish()
