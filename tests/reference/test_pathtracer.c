@@ -36,17 +36,19 @@
 #include "support/scene_util.h"
 #include "volume/scene_volume.h"
 
-/* One pixel (the camera's forward ray) with n samples. */
-static void render1(const veil_pt_medium* m, const veil_scene* s, int spp, int max_order, int stochastic, int env,
-                    double mean[4], double se[3], veil_pt_stats* st)
+/* One pixel (the camera's forward ray) with n samples, seed `seed`, lights sampled as `sampling` says
+ * (0: the default, MIS). */
+static void render1_as(const veil_pt_medium* m, const veil_scene* s, int spp, int max_order, int stochastic, int env,
+                       int sampling, uint64_t seed, double mean[4], double se[3], veil_pt_stats* st)
 {
     veil_pt_opts o = {0};
     o.width = o.height = 1;
     o.spp = spp;
     o.max_order = max_order;
-    o.seed = 7;
+    o.seed = seed;
     o.stochastic_background = stochastic;
     o.environment = env;
+    o.light_sampling = sampling;
     float *rgba = NULL, *e = NULL;
     veil_error err = {0};
     veil_result r = veil_pt_render(m, s, &o, &rgba, &e, st, &err);
@@ -58,6 +60,12 @@ static void render1(const veil_pt_medium* m, const veil_scene* s, int spp, int m
           (unsigned long long)st->dropped_samples, (unsigned long long)st->majorant_misses);
     free(rgba);
     free(e);
+}
+
+static void render1(const veil_pt_medium* m, const veil_scene* s, int spp, int max_order, int stochastic, int env,
+                    double mean[4], double se[3], veil_pt_stats* st)
+{
+    render1_as(m, s, spp, max_order, stochastic, env, 0, 7, mean, se, st);
 }
 
 static void within_4_sigma(const char* what, const double got[3], const double se[3], const double want[3],
@@ -267,25 +275,13 @@ static void test_furnace(const char* what, double g, double scale, int spp)
 
 /* ---- the environment light (scene/environment.h) ---------------------------------- */
 
-/* One pixel as render1, with the environment sampled as `sampling` says (MIS: the map and the phase
- * function; DISTANCE: the phase function alone). */
+/* One pixel as render1 (seed 11), with the environment sampled as `sampling` says (MIS: the map and the
+ * phase function; DISTANCE: the phase function alone). */
 static void render_env(const veil_pt_medium* m, const veil_scene* s, int spp, int max_order, int sampling,
                        double mean[4], double se[3])
 {
-    veil_pt_opts o = {0};
-    o.width = o.height = 1;
-    o.spp = spp;
-    o.max_order = max_order;
-    o.seed = 11;
-    o.light_sampling = sampling;
-    float *rgba = NULL, *e = NULL;
-    veil_error err = {0};
     veil_pt_stats st;
-    CHECK(veil_pt_render(m, s, &o, &rgba, &e, &st, &err) == VEIL_OK, "render: %s", err.msg);
-    for (int c = 0; c < 4; ++c) mean[c] = rgba ? rgba[c] : NAN;
-    for (int c = 0; c < 3; ++c) se[c] = e ? e[c] : NAN;
-    free(rgba);
-    free(e);
+    render1_as(m, s, spp, max_order, 0, 0, sampling, 11, mean, se, &st);
 }
 
 /* The white furnace lit by an environment light of radiance 1 (not the background): every pixel 1, with
