@@ -89,17 +89,25 @@ static const char* slab_json =
     "\"medium\":{\"sigma_a\":[0.1,0.3,0.0],\"sigma_s\":[0.5,0.2,0.9],\"sources\":[]},"
     "\"lights\":[],\"background\":{\"color\":[1.0,0.5,0.25]}}";
 
-static void test_slab(void)
+/* The slab of test_slab, test_sun_single and test_env_sun: 4^3 voxels of density 1, edge 0.5 m, from the
+ * origin (the medium is the box of the centres, [0.25, 1.75]^3). */
+static veil_pt_medium* slab_medium(const veil_scene* s)
 {
-    veil_scene s = test_parse_scene(slab_json);
-    /* 4^3 voxels of density 1, edge 0.5: the medium is the box of the
-     * centres, [0.25, 1.75]^3, so the ray along z crosses L = 1.5 m */
     veil_grid g = {{4, 4, 4}, {0, 0, 0}, 0.5f};
     float rho[64];
     for (int i = 0; i < 64; ++i) rho[i] = 1.0f;
     veil_pt_medium* m = NULL;
     veil_error err = {0};
-    CHECK(veil_pt_medium_from_density(&s, &g, rho, &m, &err) == VEIL_OK, "%s", err.msg);
+    CHECK(veil_pt_medium_from_density(s, &g, rho, &m, &err) == VEIL_OK, "%s", err.msg);
+    return m;
+}
+
+static void test_slab(void)
+{
+    veil_scene s = test_parse_scene(slab_json);
+    /* 4^3 voxels of density 1, edge 0.5: the medium is the box of the
+     * centres, [0.25, 1.75]^3, so the ray along z crosses L = 1.5 m */
+    veil_pt_medium* m = slab_medium(&s);
     double want[3], mean[4], se[3];
     for (int c = 0; c < 3; ++c)
         want[c] = s.background[c] * exp(-((double)s.medium.sigma_a[c] + s.medium.sigma_s[c]) * 1.5);
@@ -133,12 +141,7 @@ static void test_sun_single(void)
         "\"medium\":{\"sigma_a\":[0.1,0.3,0.0],\"sigma_s\":[0.5,0.2,0.9],\"phase\":{\"type\":\"hg\",\"g\":0.3},"
         "\"sources\":[]},\"lights\":[{\"type\":\"directional\",\"direction\":[0,-1,0],\"irradiance\":[2,3,4]}],"
         "\"background\":{\"color\":[0.2,0.2,0.2]}}");
-    veil_grid g = {{4, 4, 4}, {0, 0, 0}, 0.5f};
-    float rho[64];
-    for (int i = 0; i < 64; ++i) rho[i] = 1.0f;
-    veil_pt_medium* m = NULL;
-    veil_error err = {0};
-    CHECK(veil_pt_medium_from_density(&s, &g, rho, &m, &err) == VEIL_OK, "%s", err.msg);
+    veil_pt_medium* m = slab_medium(&s);
     const double gg = 0.3, p0 = (1 - gg * gg) / (4 * VEIL_PI * pow(1 + gg * gg, 1.5)), D = 0.75, C = 1.5;
     double want[3], mean[4], se[3];
     for (int c = 0; c < 3; ++c) {
@@ -337,12 +340,7 @@ static void test_env_sun(void)
     for (int j = 0; j < J; ++j)
         for (int i = 0; i < W; ++i)
             for (int c = 0; c < 3; ++c) env->rgb[3 * ((size_t)j * W + i) + c] = (float)Lc[c];
-    veil_grid g = {{4, 4, 4}, {0, 0, 0}, 0.5f};
-    float rho[64];
-    for (int i = 0; i < 64; ++i) rho[i] = 1.0f;
-    veil_pt_medium* m = NULL;
-    veil_error err = {0};
-    CHECK(veil_pt_medium_from_density(&s, &g, rho, &m, &err) == VEIL_OK, "%s", err.msg);
+    veil_pt_medium* m = slab_medium(&s);
     const double gg = 0.3, p0 = (1 - gg * gg) / (4 * VEIL_PI * pow(1 + gg * gg, 1.5)), D = 0.75, C = 1.5;
     const double tc = VEIL_PI * J / H, a = 1 + gg * gg, b = 2 * gg;
     const double p2 = 3.75 * b * b * (1 - gg * gg) / (4 * VEIL_PI) * pow(a - b * sin(tc), -3.5);
