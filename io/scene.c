@@ -45,8 +45,10 @@ static const char* const SPOT_KEYS[] = {"type", "position", "direction", "intens
                                         "outer_angle_deg", NULL};
 static const char* const* const LIGHT_KEYS[] = {POINT_KEYS, DIR_KEYS, SPOT_KEYS}; /* by veil_light_type */
 static const char* const BACKGROUND_KEYS[] = {"color", NULL};
-static const char* const ENV_KEYS[] = {"type", "color", "file", "intensity", "rotation_deg", "up", "lights", NULL};
+static const char* const ENV_KEYS[] = {"type",  "color",  "file",      "intensity", "rotation_deg",
+                                       "up",    "lights", "remainder", NULL};
 static const char* const ENV_UP[] = {"y", "z", NULL};
+static const char* const ENV_REMAINDER[] = {"cache", "lights", NULL}; /* = veil_environment.remainder_lights */
 
 static veil_result check_camera(const ctx* c, const jpath* p, const veil_camera* cam)
 {
@@ -229,7 +231,8 @@ static veil_result load_environment_map(const ctx* c, const jpath* fp, veil_envi
     return VEIL_OK;
 }
 
-/* {"type": "environment", "color" | "file", "intensity", "rotation_deg", "lights"} (scene/environment.h) */
+/* {"type": "environment", "color" | "file", "intensity", "rotation_deg", "up", "lights", "remainder"}
+ * (scene/environment.h) */
 static veil_result parse_environment(const ctx* c, const cJSON* e, const jpath* ep, veil_environment* env)
 {
     static const range ROTATION = {-1e6, 1e6, false, false, false, "a number of degrees in [-1e6, 1e6]"};
@@ -246,6 +249,7 @@ static veil_result parse_environment(const ctx* c, const cJSON* e, const jpath* 
     TRY(veil__jr_get_number(c, e, ep, "rotation_deg", false, &ROTATION, &rotation));
     TRY(veil__jr_get_int(c, e, ep, "lights", &LIGHTS, &env->lights));
     TRY(veil__jr_get_name(c, e, ep, "up", ENV_UP, &env->up_z));
+    TRY(veil__jr_get_name(c, e, ep, "remainder", ENV_REMAINDER, &env->remainder_lights));
     TRY(veil__get_string(c, e, ep, "file", false, &env->file));
     env->rotation_deg = (float)rotation;
     float tint[3];

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/hash.h"
 #include "../core/shared.glsl.h"
 
 #define ENV_PI 3.14159265358979323846
@@ -112,21 +113,35 @@ typedef struct {
     double energy;      /* luminance x solid angle summed */
 } env_region;
 
+typedef enum { PART_ALL, PART_BRIGHT, PART_REST } env_part;
+
 typedef struct {
     int w, h;
     const float* rgb; /* w * h * 3 */
     float one[3];     /* a constant sky's colour (rgb NULL) */
+    env_part part;    /* the whole map, or its bright part or its rest above and below `clip` */
+    double clip;      /* the split's luminance (veil_env_split) */
 } env_map;
 
-static const float* map_texel(const env_map* m, int i, int j)
+/* The radiance t split at luminance clip: the rest is t scaled down to luminance clip where it is above it
+ * (its colour kept), the bright part what that took away. */
+static void split_texel(const float t[3], double clip, env_part part, double out[3])
 {
-    return m->rgb ? m->rgb + 3 * ((size_t)j * (size_t)m->w + (size_t)i) : m->one;
+    double c[3] = {t[0], t[1], t[2]}, l = luminance(c);
+    double keep = l > clip ? clip / l : 1.0; /* (l > clip > 0 here) */
+    for (int k = 0; k < 3; ++k) out[k] = part == PART_ALL ? c[k] : part == PART_REST ? c[k] * keep : c[k] * (1.0 - keep);
+}
+
+static void map_texel(const env_map* m, int i, int j, double out[3])
+{
+    const float* t = m->rgb ? m->rgb + 3 * ((size_t)j * (size_t)m->w + (size_t)i) : m->one;
+    split_texel(t, m->clip, m->part, out);
 }
 
 static double texel_energy(const env_map* m, int i, int j)
 {
-    const float* t = map_texel(m, i, j);
-    double c[3] = {t[0], t[1], t[2]};
+    double c[3];
+    map_texel(m, i, j, c);
     return luminance(c) * veil_env_texel_solid_angle(m->w, m->h, j);
 }
 
@@ -180,8 +195,9 @@ static int region_light(const env_map* m, const veil_environment* e, const env_r
         double dw = veil_env_texel_solid_angle(m->w, m->h, j);
         double ct = cos(ENV_PI * (j + 0.5) / m->h);
         for (int i = r->i0; i < r->i1; ++i) {
-            const float* t = map_texel(m, i, j);
-            double rgb[3] = {t[0], t[1], t[2]}, dir[3], wt = luminance(rgb) * dw;
+            double rgb[3], dir[3];
+            map_texel(m, i, j, rgb);
+            double wt = luminance(rgb) * dw;
             direction_at(ct, 2.0 * ENV_PI * (i + 0.5) / m->w, dir);
             for (int k = 0; k < 3; ++k) c[k] += rgb[k] * dw, d[k] += wt * dir[k];
         }
@@ -200,27 +216,58 @@ static int region_light(const env_map* m, const veil_environment* e, const env_r
     return 1;
 }
 
-int veil_env_median_cut(const veil_environment* e, int max, veil_light* out)
+/* The part of region r with light: its bounding box of texels with energy (0 when it has none). */
+static int lit_box(const env_map* m, const env_region* r, env_region* out)
+{
+    int i0 = r->i1, i1 = r->i0, j0 = r->j1, j1 = r->j0;
+    for (int j = r->j0; j < r->j1; ++j)
+        for (int i = r->i0; i < r->i1; ++i)
+            if (texel_energy(m, i, j) > 0.0) {
+                i0 = i < i0 ? i : i0, i1 = i + 1 > i1 ? i + 1 : i1;
+                j0 = j < j0 ? j : j0, j1 = j + 1 > j1 ? j + 1 : j1;
+            }
+    if (i0 >= i1) return 0;
+    *out = (env_region){i0, i1, j0, j1, r->energy};
+    return 1;
+}
+
+/* A region's extent in angle: across (at its widest row) and along the meridians, the larger (radians). */
+static double region_extent(const env_map* m, const env_region* r)
+{
+    double t0 = ENV_PI * r->j0 / m->h, t1 = ENV_PI * r->j1 / m->h;
+    double widest = t0 <= 0.5 * ENV_PI && t1 >= 0.5 * ENV_PI ? 1.0 : fmax(sin(t0), sin(t1));
+    return fmax((r->i1 - r->i0) * (2.0 * ENV_PI / m->w) * widest, t1 - t0);
+}
+
+/* The median cut of m's part (the whole map, or its bright part: regions shrunk to their lit texels, and
+ * one under VEIL_ENV_POINT_DEG across is not split: it is a sun already). */
+static int median_cut(const veil_environment* e, env_part part, int max, veil_light* out)
 {
     if (!e || !e->present || !e->rgb || max <= 0) return 0;
-    env_map m = {e->width, e->height, e->rgb, {0, 0, 0}};
+    env_map m = {e->width, e->height, e->rgb, {0, 0, 0}, part, e->clip};
     if (e->width == 1 && e->height == 1) { /* a constant sky: cut as a 64 x 32 map of itself */
         m.w = 64, m.h = 32, m.rgb = NULL;
         memcpy(m.one, e->rgb, sizeof m.one);
     }
+    const int shrink = part == PART_BRIGHT;
     env_region regions[VEIL_MAX_LIGHTS];
     if (max > VEIL_MAX_LIGHTS) max = VEIL_MAX_LIGHTS;
     int n = 1;
     regions[0] = (env_region){0, m.w, 0, m.h, region_energy(&m, 0, m.w, 0, m.h)};
+    if (shrink && !lit_box(&m, &regions[0], &regions[0])) return 0;
+    const double point = VEIL_ENV_POINT_DEG * (ENV_PI / 180.0);
     while (n < max) {
         int pick = -1;
         for (int r = 0; r < n; ++r) /* the region carrying the most light that can still be split */
             if ((regions[r].i1 - regions[r].i0 > 1 || regions[r].j1 - regions[r].j0 > 1) &&
+                !(shrink && region_extent(&m, &regions[r]) <= point) &&
                 (pick < 0 || regions[r].energy > regions[pick].energy))
                 pick = r;
         if (pick < 0 || !(regions[pick].energy > 0.0)) break;
         env_region a, b;
         if (!split(&m, &regions[pick], &a, &b)) break;
+        /* (a lit box's edges are lit, so both halves have light; were one dark, the cut stops there) */
+        if (shrink && (!lit_box(&m, &a, &a) || !lit_box(&m, &b, &b))) break;
         regions[pick] = a;
         regions[n++] = b;
     }
@@ -229,11 +276,110 @@ int veil_env_median_cut(const veil_environment* e, int max, veil_light* out)
     return lights;
 }
 
+int veil_env_median_cut(const veil_environment* e, int max, veil_light* out)
+{
+    return median_cut(e, PART_ALL, max, out);
+}
+
+int veil_env_bright_cut(const veil_environment* e, int max, veil_light* out)
+{
+    return median_cut(e, PART_BRIGHT, max, out);
+}
+
+double veil_env_mean_luminance(const veil_environment* e)
+{
+    double total[3];
+    veil_env_integral(e, total);
+    return luminance(total) / (4.0 * ENV_PI);
+}
+
+void veil_env_part_integral(const veil_environment* e, int bright, double out[3])
+{
+    out[0] = out[1] = out[2] = 0.0;
+    if (!e || !e->present || !e->rgb) return;
+    env_map m = {e->width, e->height, e->rgb, {0, 0, 0}, bright ? PART_BRIGHT : PART_REST, e->clip};
+    for (int j = 0; j < m.h; ++j) {
+        double dw = veil_env_texel_solid_angle(m.w, m.h, j);
+        for (int i = 0; i < m.w; ++i) {
+            double c[3];
+            map_texel(&m, i, j, c);
+            for (int k = 0; k < 3; ++k) out[k] += c[k] * dw;
+        }
+    }
+}
+
+void veil_env_frame(const veil_environment* e, float axes[3][3])
+{
+    for (int a = 0; a < 3; ++a) {
+        double in[3] = {a == 0, a == 1, a == 2}, o[3];
+        rotate(e, in, o, 1.0);
+        for (int k = 0; k < 3; ++k) axes[a][k] = (float)o[k];
+    }
+}
+
+veil_result veil_env_rest_table(const veil_environment* e, size_t max_texels, veil_env_table* t, veil_error* err)
+{
+    memset(t, 0, sizeof *t);
+    if (!e || !e->present || !e->rgb) return VEIL_OK;
+    const int w = e->width, h = e->height;
+    int f = 1;
+    while ((size_t)((w + f - 1) / f) * (size_t)((h + f - 1) / f) > max_texels) f *= 2;
+    const int tw = (w + f - 1) / f, th = (h + f - 1) / f;
+    float* en = malloc((size_t)tw * th * 8 * sizeof *en);
+    if (!en) return veil_fail(err, VEIL_ERR_OOM, "out of memory for the environment's photon table (%dx%d)", tw, th);
+    env_map m = {w, h, e->rgb, {0, 0, 0}, PART_REST, e->clip};
+    double total = 0.0, bound = 0.0;
+    int n = 0;
+    for (int bj = 0; bj < th; ++bj)
+        for (int bi = 0; bi < tw; ++bi) {
+            double c[3] = {0, 0, 0}; /* the block's rgb x solid angle */
+            for (int j = bj * f; j < (bj + 1) * f && j < h; ++j) {
+                double dw = veil_env_texel_solid_angle(w, h, j);
+                for (int i = bi * f; i < (bi + 1) * f && i < w; ++i) {
+                    double r[3];
+                    map_texel(&m, i, j, r);
+                    for (int k = 0; k < 3; ++k) c[k] += r[k] * dw;
+                }
+            }
+            double l = luminance(c);
+            if (!(l > 0.0)) continue;
+            total += l;
+            float* q = en + 8 * (size_t)n++;
+            q[0] = (float)(bj * tw + bi);
+            q[1] = (float)total; /* divided by the total below */
+            q[2] = q[3] = q[7] = 0.0f;
+            for (int k = 0; k < 3; ++k) {
+                q[4 + k] = (float)(c[k] / l);
+                bound = fmax(bound, c[k] / l);
+            }
+        }
+    for (int k = 0; k < n; ++k) en[8 * (size_t)k + 1] = k == n - 1 ? 1.0f : (float)(en[8 * (size_t)k + 1] / total);
+    t->w = tw, t->h = th, t->block = f, t->n = n;
+    t->entries = en;
+    t->total = total;
+    t->bound = bound;
+    if (n == 0) veil_env_table_free(t);
+    return VEIL_OK;
+}
+
+void veil_env_table_free(veil_env_table* t)
+{
+    free(t->entries);
+    memset(t, 0, sizeof *t);
+}
+
 void veil_env_make_cuts(veil_environment* e, int room, const int* rungs, int n)
 {
     e->cut_sets = 0;
     e->room = room < 0 ? 0 : room > VEIL_MAX_LIGHTS ? VEIL_MAX_LIGHTS : room;
-    if (!e->present || e->room == 0) return;
+    if (!e->present) return;
+    e->clip = VEIL_ENV_CLIP * veil_env_mean_luminance(e);
+    uint64_t key = veil_hash_bytes(VEIL_FNV_OFFSET, &e->width, sizeof e->width);
+    key = veil_hash_bytes(key, &e->height, sizeof e->height);
+    key = veil_hash_bytes(key, &e->rotation_deg, sizeof e->rotation_deg);
+    key = veil_hash_bytes(key, &e->up_z, sizeof e->up_z);
+    e->key = veil_hash_words(key, e->rgb, (size_t)e->width * e->height * 3 * sizeof *e->rgb);
+    if (e->room == 0) return;
     const int one = e->lights;
     if (one > 0) rungs = &one, n = 1;
     for (int r = 0; r < n && e->cut_sets < VEIL_ENV_CUTS; ++r) {
@@ -243,6 +389,7 @@ void veil_env_make_cuts(veil_environment* e, int room, const int* rungs, int n)
         veil_env_cut* cut = &e->cuts[e->cut_sets++];
         cut->k = k;
         cut->count = veil_env_median_cut(e, k, cut->lights);
+        cut->bright_count = veil_env_bright_cut(e, k, cut->bright);
     }
 }
 
@@ -281,7 +428,7 @@ veil_result veil_env_dist_make(veil_environment* e, veil_error* err)
         free(d);
         return veil_fail(err, VEIL_ERR_OOM, "out of memory for the environment's sampling tables (%dx%d)", w, h);
     }
-    env_map m = {w, h, e->rgb, {0, 0, 0}};
+    env_map m = {w, h, e->rgb, {0, 0, 0}, PART_ALL, 0.0};
     double total = 0.0;
     for (int j = 0; j < h; ++j)
         for (int i = 0; i < w; ++i) total += texel_energy(&m, i, j);

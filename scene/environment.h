@@ -53,6 +53,14 @@
 #define VEIL_ENV_LIGHTS_DEFAULT 8
 #define VEIL_ENV_LIGHTS_HIGH 16
 #define VEIL_ENV_MAX_TEXELS ((size_t)1 << 25) /* an 8K map, 8192 x 4096 */
+/* The split, where the light cache carries the remainder (frame/stages.h, docs/accuracy.md): a texel's
+ * luminance above VEIL_ENV_CLIP times the map's mean (over the sphere) is its bright part, the median cut's;
+ * the rest, at most that luminance, is the cache's photons'. A region of the bright part under
+ * VEIL_ENV_POINT_DEG across is one light (a sun), not split further. */
+#define VEIL_ENV_CLIP 8.0
+#define VEIL_ENV_POINT_DEG 4.0
+/* The rest's photon table holds at most this many texels (a larger map is averaged over blocks of texels) */
+#define VEIL_ENV_TABLE_TEXELS ((size_t)1 << 19)
 
 typedef struct veil_env_dist veil_env_dist;
 
@@ -60,6 +68,8 @@ typedef struct veil_env_dist veil_env_dist;
 typedef struct veil_env_cut {
     int k, count;
     veil_light lights[VEIL_MAX_LIGHTS];
+    int bright_count;                   /* the bright part's cut (veil_env_bright_cut), for the same k */
+    veil_light bright[VEIL_MAX_LIGHTS];
 } veil_env_cut;
 
 typedef struct veil_environment {
@@ -71,10 +81,15 @@ typedef struct veil_environment {
     int lights;        /* "lights": how many directional lights the GPU pipeline carries it as, 1..VEIL_MAX_LIGHTS;
                           0: the quality rung's (frame/stages.h: draft 4, default 8, high and max 16) */
     int room;          /* at most this many: VEIL_MAX_LIGHTS less the scene's other lights */
+    int remainder_lights; /* "remainder": "lights": the whole map is the median cut's, even under the light cache
+                             (0, "cache": where the cache is the volumetric method, the cut carries the bright
+                             part and the cache's photons the rest: veil_env_bright_cut) */
     char* file;        /* the map's file, resolved (owned); NULL: a constant colour */
     size_t light_index; /* where it stood among the scene file's lights (for messages) */
     veil_env_dist* dist; /* the sampling distribution, made on first need (veil_env_dist_make; owned) */
     veil_env_cut cuts[VEIL_ENV_CUTS]; /* made once when the scene is read (veil_env_make_cuts) */
+    double clip;       /* the split's luminance: VEIL_ENV_CLIP times the mean (set by veil_env_make_cuts) */
+    unsigned long long key; /* the map's content (size, texels, rotation, up) hashed, for the cache's key (ditto) */
     int cut_sets;
 } veil_environment;
 
@@ -102,6 +117,33 @@ void veil_env_integral(const veil_environment* e, double out[3]);
  * number of lights written (0 when the environment is black); the sum of
  * their irradiances is veil_env_integral's, up to rounding. */
 int veil_env_median_cut(const veil_environment* e, int max, veil_light* out);
+
+/* The split at e->clip: each texel's radiance scaled down to luminance clip where it is above it is the
+ * rest, what that takes away the bright part (the two sum to the map). The bright part's median cut (as
+ * veil_env_median_cut, but each region first shrunk to its texels with light, and one under
+ * VEIL_ENV_POINT_DEG across not split): up to max lights, 0 when no texel is above the clip (a constant
+ * sky, a smooth one). */
+int veil_env_bright_cut(const veil_environment* e, int max, veil_light* out);
+/* The mean luminance of the radiance over the sphere. */
+double veil_env_mean_luminance(const veil_environment* e);
+/* The integral over the sphere of the bright part (bright 1) or the rest (0), rgb. */
+void veil_env_part_integral(const veil_environment* e, int bright, double out[3]);
+/* The world images of the map frame's axes x, y, z (rotation and up applied): a map-frame direction m is
+ * the world's m[0] axes[0] + m[1] axes[1] + m[2] axes[2]. */
+void veil_env_frame(const veil_environment* e, float axes[3][3]);
+
+/* The rest as a table for photons (the light cache's: volumetric/cache.h): the map averaged over blocks of
+ * block x block texels (1, unless it has over max_texels) into a w x h map; of its n texels with light,
+ * entry k is 8 floats: the texel's index (row-major, row 0 the top), the CDF of luminance x solid angle up
+ * to and with it, 0, 0, its rgb / luminance, 0. total: the sum of luminance x solid angle (W/m^2);
+ * bound: the largest rgb / luminance. No light: n 0, entries NULL. */
+typedef struct veil_env_table {
+    int w, h, block, n;
+    float* entries;
+    double total, bound;
+} veil_env_table;
+veil_result veil_env_rest_table(const veil_environment* e, size_t max_texels, veil_env_table* t, veil_error* err);
+void veil_env_table_free(veil_env_table* t);
 
 /* Makes e's cuts for `room` lights at most: the one of e->lights, or with lights 0 one for each of the
  * counts rungs[0 .. n) (each at most room; equal ones once). */

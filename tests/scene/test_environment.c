@@ -1,7 +1,8 @@
 /* The environment light (scene/environment.h): the lat-long convention and rotation as documented, the
  * texels' solid angles, the median cut's lights (their irradiance is the map's integral; a sun's light
  * points at the sun), the importance sampling's pdf (consistent with its samples, normalised, and
- * proportional to luminance: luminance / pdf is the same for every sample), and the scene reader
+ * proportional to luminance: luminance / pdf is the same for every sample), the split into a bright part
+ * and a rest (test_split says what is checked), and the scene reader
  * (a constant sky, a map from an EXR, every bad field refused with its path). */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -236,6 +237,95 @@ static void test_sampling(void)
     veil_env_free(&e);
 }
 
+/* The split (scene/environment.h): the bright part and the rest sum to the map; the rest is the map with
+ * each texel's luminance capped at the clip (computed here from the texels, independently); a constant sky
+ * has no bright part; a sun under VEIL_ENV_POINT_DEG across is one light carrying the bright part, along
+ * it; two suns far apart are two lights (the regions shrink to their lit texels); the photons' table holds
+ * the rest's luminance integral, with a CDF that rises to 1, in blocks or not. */
+static void test_split(void)
+{
+    veil_light L[VEIL_MAX_LIGHTS];
+    const double s[3] = {0.48, 0.6, -0.64};
+    static const int rungs[1] = {8};
+    veil_environment e = sun_map(256, 128, s, 1.5, 2000.0f, 0.3f); /* a disc of 1.5 degrees' radius: 3 across */
+    e.lights = 0;
+    veil_env_make_cuts(&e, 16, rungs, 1);
+    double all[3], bright[3], rest[3], mine[3] = {0, 0, 0}, total[3];
+    veil_env_integral(&e, all);
+    veil_env_part_integral(&e, 1, bright);
+    veil_env_part_integral(&e, 0, rest);
+    CHECK(fabs(e.clip - 8.0 * lum(all) / (4 * PI)) <= 1e-12 * e.clip, "the clip %.9g is not 8 times the mean", e.clip);
+    for (int j = 0; j < 128; ++j)
+        for (int i = 0; i < 256; ++i) {
+            const float* t = e.rgb + 3 * ((size_t)j * 256 + i);
+            double c[3] = {t[0], t[1], t[2]}, l = lum(c), dw = veil_env_texel_solid_angle(256, 128, j);
+            for (int k = 0; k < 3; ++k) mine[k] += (l > e.clip ? c[k] * e.clip / l : c[k]) * dw;
+        }
+    int parts = 1;
+    for (int k = 0; k < 3; ++k)
+        parts &= fabs(bright[k] + rest[k] - all[k]) <= 1e-9 * all[k] && fabs(rest[k] - mine[k]) <= 1e-9 * mine[k];
+    CHECK(parts, "bright %.9g + rest %.9g is not the map %.9g, or the rest is not the clipped map %.9g", bright[1],
+          rest[1], all[1], mine[1]);
+    CHECK(bright[1] > 0.5 * all[1], "the sun is the bright part: %.4g of %.4g", bright[1], all[1]);
+    int n = veil_env_bright_cut(&e, 8, L);
+    const double ns = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    double cosd = n == 1 ? -(L[0].direction[0] * s[0] + L[0].direction[1] * s[1] + L[0].direction[2] * s[2]) / ns : 0.0;
+    CHECK(n == 1 && cosd > cos(0.2 * PI / 180.0) && fabs(L[0].color[1] - bright[1]) <= 1e-5 * bright[1],
+          "a 3-degree sun: %d bright lights (1), along the sun within %.3g degrees (0.2), irradiance %.6g of %.6g", n,
+          acos(fmin(1.0, cosd)) * 180.0 / PI, n ? L[0].color[1] : 0.0, bright[1]);
+    const veil_env_cut* cut = veil_env_cut_for(&e, 8);
+    CHECK(cut && cut->bright_count == 1 && cut->count == 8, "the kept cut: %d bright lights (1), %d whole (8)",
+          cut ? cut->bright_count : -1, cut ? cut->count : -1);
+    /* the table: the rest's luminance integral, its CDF rising to 1; in blocks of 4 (a table of 1/16 the
+     * texels) the same total, up to rounding */
+    veil_error err = {0};
+    for (int f = 1; f <= 4; f *= 4) {
+        veil_env_table t;
+        CHECK(veil_env_rest_table(&e, (size_t)256 * 128 / (size_t)(f * f), &t, &err) == VEIL_OK, "%s", err.msg);
+        int rising = t.n > 0 && t.entries[8 * (size_t)(t.n - 1) + 1] == 1.0f, chroma = 1;
+        for (int k = 1; k < t.n; ++k) rising &= t.entries[8 * (size_t)k + 1] >= t.entries[8 * (size_t)k - 7];
+        for (int k = 0; k < t.n; ++k) {
+            const float* q = t.entries + 8 * (size_t)k;
+            double c[3] = {q[4], q[5], q[6]};
+            chroma &= fabs(lum(c) - 1.0) <= 1e-6 && q[0] >= 0.0f && q[0] < (float)(t.w * t.h);
+        }
+        CHECK(t.block == f && t.w == 256 / f && t.h == 128 / f && t.n == t.w * t.h && rising && chroma &&
+                  fabs(t.total - lum(rest)) <= 1e-9 * lum(rest) && t.bound >= 1.0,
+              "table in blocks of %d: %dx%d (block %d), %d entries, CDF rising to 1: %d, rgb / lum of luminance 1: "
+              "%d, total %.9g of %.9g", f, t.w, t.h, t.block, t.n, rising, chroma, t.total, lum(rest));
+        veil_env_table_free(&t);
+    }
+    veil_env_free(&e);
+    /* a constant sky: no bright part */
+    memset(&e, 0, sizeof e);
+    e.present = 1, e.width = e.height = 1;
+    e.rgb = malloc(3 * sizeof *e.rgb);
+    e.rgb[0] = 0.5f, e.rgb[1] = 0.6f, e.rgb[2] = 0.9f;
+    veil_env_make_cuts(&e, 16, rungs, 1);
+    veil_env_part_integral(&e, 0, rest);
+    veil_env_integral(&e, total);
+    CHECK(veil_env_bright_cut(&e, 8, L) == 0 && fabs(rest[2] - total[2]) <= 1e-12 * total[2],
+          "a constant sky: %d bright lights, rest %.9g of %.9g", veil_env_bright_cut(&e, 8, L), rest[2], total[2]);
+    veil_env_free(&e);
+    /* two suns a right angle apart: two lights, one along each */
+    const double s2[3] = {-0.64, 0.6, 0.48};
+    e = sun_map(256, 128, s, 1.5, 2000.0f, 0.3f);
+    veil_environment e2 = sun_map(256, 128, s2, 1.5, 2000.0f, 0.3f);
+    for (size_t k = 0; k < (size_t)256 * 128 * 3; ++k) e.rgb[k] = fmaxf(e.rgb[k], e2.rgb[k]);
+    veil_env_free(&e2);
+    veil_env_make_cuts(&e, 16, rungs, 1);
+    n = veil_env_bright_cut(&e, 8, L);
+    int along = 0;
+    for (int l = 0; l < n; ++l)
+        for (int q = 0; q < 2; ++q) {
+            const double* d = q ? s2 : s;
+            along += -(L[l].direction[0] * d[0] + L[l].direction[1] * d[1] + L[l].direction[2] * d[2]) / ns >
+                     cos(0.2 * PI / 180.0);
+        }
+    CHECK(n == 2 && along == 2, "two suns: %d bright lights (2), %d along a sun (2)", n, along);
+    veil_env_free(&e);
+}
+
 /* JSON with single quotes (turned into double) parsed with base folder g_dir. */
 static veil_result parse(const char* text, veil_scene* s, veil_error* e)
 {
@@ -324,6 +414,14 @@ static void test_scene(void)
     expect_bad(HEAD "{'type':'environment','color':[1,1,1],'rotation_deg':'x'}]}", "lights[0].rotation_deg");
     expect_bad(HEAD "{'type':'environment','color':[1,1,1],'sun':1}]}", "lights[0].sun: unknown key");
     expect_bad(HEAD "{'type':'environment','color':[1,1,1],'up':'x'}]}", "lights[0].up: expected one of");
+    expect_bad(HEAD "{'type':'environment','color':[1,1,1],'remainder':'photons'}]}",
+               "lights[0].remainder: expected one of");
+    r = parse(HEAD "{'type':'environment','color':[1,1,1],'remainder':'lights'}]}", &s, &e);
+    CHECK(r == VEIL_OK && s.environment.remainder_lights == 1, "remainder lights: %s", e.msg);
+    if (r == VEIL_OK) veil_scene_free(&s);
+    r = parse(HEAD "{'type':'environment','color':[1,1,1]}]}", &s, &e);
+    CHECK(r == VEIL_OK && s.environment.remainder_lights == 0, "remainder cache by default: %s", e.msg);
+    if (r == VEIL_OK) veil_scene_free(&s);
     expect_bad(HEAD "{'type':'environment','file':'missing.exr'}]}", "lights[0].file: cannot open");
     expect_bad(HEAD "{'type':'environment','file':'nan.exr'}]}", "nan.exr': texel (2, 1) has G NaN");
     expect_bad(HEAD "{'type':'environment','file':'small.exr'}]}", "an environment map of 1x1 texels");
@@ -348,6 +446,7 @@ int main(void)
     test_solid_angles();
     test_median_cut();
     test_sampling();
+    test_split();
     test_scene();
     const char* names[] = {"sky.exr", "nan.exr", "small.exr", "text.exr"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
