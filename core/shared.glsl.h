@@ -390,7 +390,8 @@ VEIL_STRUCT_END(veil_diffusion_block)
 /* SSBO bindings of the cache's own passes (GL guarantees 8: 0..7) */
 #define VEIL_BIND_CACHE_SUM 0      /* uint[cells * VEIL_CACHE_WORDS] */
 #define VEIL_BIND_CACHE_CELL 1     /* vec2[cells]: majorant density, emission weight */
-#define VEIL_BIND_CACHE_EMIT 2     /* the emitting cells: uvec2 (cell, the CDF up to it as float bits) */
+#define VEIL_BIND_CACHE_EMIT 2     /* the emitting cells: uvec4 (cell, the CDF up to it and p as float bits, -);
+                                      for the environment, its table (veil_env_table: two uvec4 of float bits) */
 #define VEIL_BIND_CACHE_COUNT 3    /* uint[4]: photons cut at the step cap, scores clamped, majorant misses, -;
                                       then the energy account's int64 sums (below) */
 #define VEIL_BIND_CACHE_FREE 4     /* float[cells]: the part of each cell not inside a frame's solid (scene/solid.h),
@@ -449,6 +450,7 @@ VEIL_STRUCT_END(veil_diffusion_block)
 #define VEIL_CACHE_SUN 0
 #define VEIL_CACHE_CONE 1          /* point and spot lights: directions in a cone */
 #define VEIL_CACHE_EMISSION 2      /* the medium's emission, by cell */
+#define VEIL_CACHE_ENV 3           /* the environment's rest (scene/environment.h), by texel block */
 
 VEIL_STRUCT_BEGIN(veil_cache_block)
     VEIL_V4(origin);   /* xyz: the grid's min corner (m); w: cell edge h (m) */
@@ -457,13 +459,17 @@ VEIL_STRUCT_BEGIN(veil_cache_block)
     VEIL_V4(sigma_s);  /* rgb: m^-1 per unit density; w: HG g */
     VEIL_V4(scale);    /* x: units per score (W/m^2)^-1, y: W/m^2 per unit, z: 1 / V (m^-3), w: max sigma_t per density */
     VEIL_UV4(source);  /* x: VEIL_CACHE_*, y: the light, z: the first photon of this dispatch, w: photons of the source */
-    VEIL_UV4(seed);    /* x: the seed, y: the source's index among the cache's, z: a photon's step cap, w: - */
+    VEIL_UV4(seed);    /* x: the seed, y: the source's index among the cache's, z: a photon's step cap, w: 1: a
+                          photon ends at its first scattering (the medium is too thick for more) */
     VEIL_V4(power);    /* rgb: W per photon (sun, cone: before a spot's falloff; emission: W per photon per
                           (W m^-3 sr^-1 of emission, 1 / p of the cell)), w: the energy account's units per W */
-    VEIL_V4(src0);     /* sun: a corner of the rectangle photons start on; cone: the apex (m) */
-    VEIL_V4(src1);     /* sun: the rectangle's first edge (m); cone: the axis (unit), w: cos of the half-angle */
-    VEIL_V4(src2);     /* sun: the second edge (m); w: - */
-    VEIL_V4(src3);     /* sun: the travel direction (unit) */
+    VEIL_V4(src0);     /* sun: a corner of the rectangle photons start on; cone: the apex (m); environment:
+                          the centre of the grid's bounding sphere (m), w: its radius (m) */
+    VEIL_V4(src1);     /* sun: the rectangle's first edge (m); cone: the axis (unit), w: cos of the half-angle;
+                          environment: the map frame's x axis in the world, w: the map's width (texels) */
+    VEIL_V4(src2);     /* sun: the second edge (m); environment: the frame's y axis, w: the map's height */
+    VEIL_V4(src3);     /* sun: the travel direction (unit); environment: the frame's z axis, w: the table's
+                          block (texels a side) */
 VEIL_STRUCT_END(veil_cache_block)
 
 /* The fixed point: a score s >= 0 (or a signed flux component) is added as

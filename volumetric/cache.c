@@ -104,7 +104,8 @@ typedef struct source {
     veil_cache_block b; /* the source's own fields: source.x, y; power (W, all photons); src0..3 */
     double power;       /* luminance W reaching the grid (about): the photons' share */
     double bound;       /* the largest channel of a photon's power times its photons (W) */
-    int emitters;       /* the emission: cells in its list */
+    int emitters;       /* the emission: cells in its list; the environment: its table's entries */
+    GLuint table;       /* the buffer at VEIL_BIND_CACHE_EMIT while its photons run (the environment's table) */
     long long photons;
 } source;
 
@@ -185,6 +186,33 @@ static int cone_source(const veil_gpu_light* l, const float lo[3], const float h
     return s->power > 0.0;
 }
 
+/* The environment's rest (scene/environment.h) from its table t: photons on a disc across their direction
+ * that covers the grid's bounding sphere, upstream of it. */
+static int env_source(const veil_environment* e, const veil_env_table* t, const float lo[3], const float hi[3],
+                      source* s)
+{
+    float axes[3][3];
+    veil_env_frame(e, axes);
+    double r2 = 0.0, d[3];
+    for (int a = 0; a < 3; ++a) {
+        d[a] = (double)hi[a] - lo[a];
+        r2 += 0.25 * d[a] * d[a];
+        s->b.src0[a] = 0.5f * (lo[a] + hi[a]);
+        s->b.src1[a] = axes[0][a], s->b.src2[a] = axes[1][a], s->b.src3[a] = axes[2][a];
+    }
+    const double r = sqrt(r2) * 1.001 + 1e-6, area = VEIL_PI * r * r; /* (the disc wholly outside the sphere) */
+    s->b.src0[3] = (float)r;
+    s->b.src1[3] = (float)e->width, s->b.src2[3] = (float)e->height, s->b.src3[3] = (float)t->block;
+    for (int c = 0; c < 3; ++c) s->b.power[c] = (float)(t->total * area); /* times the entry's rgb / lum */
+    s->b.source[0] = VEIL_CACHE_ENV;
+    /* the luminance entering the grid: the sky's luminance integral times the box's mean projected area,
+     * a quarter of its surface (Cauchy); exact for a constant sky */
+    s->power = t->total * 0.5 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
+    s->bound = t->total * area * t->bound;
+    s->emitters = t->n;
+    return s->power > 0.0 && t->n > 0;
+}
+
 /* ---- the build --------------------------------------------------------- */
 
 static void unbind_all(void)
@@ -241,10 +269,11 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     b.seed[0] = s->seed;
 
     GLuint buf[5] = {0, 0, 0, 0, 0}; /* sums, cells, emitters, counts, free parts */
-    GLuint medium_ubo = 0;
+    GLuint medium_ubo = 0, env_buf = 0;
+    veil_env_table table = {0};
     float* cellv = NULL;
     uint32_t* emit = NULL;
-    source src[VEIL_MAX_LIGHTS + 1];
+    source src[VEIL_MAX_LIGHTS + 2];
     int n_src = 0;
     r = veil_gl_buffer(NULL, cells * VEIL_CACHE_WORDS * sizeof(uint32_t), GL_DYNAMIC_STORAGE_BIT, "veil cache sums",
                        &buf[0], err);
@@ -352,18 +381,42 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     long long photons = s->photons;
     rep->steps = steps;
     rep->asked = s->photons;
+    /* the environment's rest: its photons' table */
+    const veil_environment* env = &md->scene->environment;
+    int env_src = 0; /* 1: the rest is a source, env_so */
+    source env_so;
+    memset(&env_so, 0, sizeof env_so);
+    if (s->environment && env->present) {
+        r = veil_env_rest_table(env, s->env_texels > 0 ? s->env_texels : VEIL_ENV_TABLE_TEXELS, &table, err);
+        if (r != VEIL_OK) goto done;
+        if (table.n > 0 && env_source(env, &table, lo, hi, &env_so)) {
+            r = veil_gl_buffer(table.entries, (size_t)table.n * 8 * sizeof *table.entries, 0,
+                               "veil cache environment table", &env_buf, err);
+            if (r != VEIL_OK) goto done;
+            env_so.table = env_buf;
+            env_src = 1;
+            veil_env_part_integral(env, 0, rep->env_rest);
+        }
+        veil_env_table_free(&table);
+    }
     if (steps * (double)photons > budget) {
         photons = (long long)(budget / steps);
-        if (photons < VEIL_CACHE_MIN_PHOTONS) { /* too thick: no cache */
+        if (photons < VEIL_CACHE_MIN_PHOTONS) { /* too thick: no cache, or the environment's rest to its first scattering */
             rep->too_thick = 1;
-            glDeleteTextures(1, tex);
-            *tex = 0;
-            goto done;
+            if (!env_src) {
+                glDeleteTextures(1, tex);
+                *tex = 0;
+                goto done;
+            }
+            src[0] = env_so;
+            n_src = 1;
+            photons = s->photons;
+            b.seed[3] = 1;
         }
     }
-    rep->cap = (int)fmin(VEIL_CACHE_MAX_CUT, fmax(VEIL_CACHE_MIN_CUT, 8.0 * steps));
+    rep->cap = rep->too_thick ? VEIL_CACHE_MAX_CUT : (int)fmin(VEIL_CACHE_MAX_CUT, fmax(VEIL_CACHE_MIN_CUT, 8.0 * steps));
     b.seed[2] = (uint32_t)rep->cap;
-    if (emitters > 0) {
+    if (emitters > 0 && !rep->too_thick) {
         emit = malloc((size_t)emitters * 4 * sizeof *emit);
         if (!emit) {
             r = veil_fail(err, VEIL_ERR_OOM, "out of memory listing the light cache's emitting cells");
@@ -396,7 +449,9 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
         /* a photon's channel c: 4 pi V eps_c(x) / (p_k N) with eps_c(x) <= w_k and p_k = w_k / total */
         so->bound = 4.0 * VEIL_PI * volume * emit_total;
         so->emitters = emitters;
+        so->table = buf[2];
     }
+    if (env_src && !rep->too_thick) src[n_src++] = env_so; /* the environment's rest, last */
 
     /* 3. the photons: shared by power (a quarter evenly), at least one a source */
     double total = 0.0;
@@ -420,7 +475,6 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
     /* (as the shader holds it: a float) */
     const double units_e = (float)(phi_max > 0.0 ? ldexp(1.0, VEIL_CACHE_FIXED_BITS) / (3.0 * phi_max) : 1.0);
     glUseProgram(p->trace[2 * solid + sparse]);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_CACHE_EMIT, buf[2]);
     const int report = veil_progress_wanted();
     long long sent = 0;
     for (int j = 0; j < n_src; ++j) {
@@ -435,6 +489,7 @@ veil_result veil__cache_build(veil_cache_programs* p, const veil_lit_medium* md,
             b.src0[c] = o->src0[c], b.src1[c] = o->src1[c], b.src2[c] = o->src2[c], b.src3[c] = o->src3[c];
         }
         b.power[3] = (float)units_e;
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_CACHE_EMIT, src[j].table);
         for (long long first = 0; first < src[j].photons; first += CACHE_DISPATCH_PHOTONS) {
             long long n = src[j].photons - first < CACHE_DISPATCH_PHOTONS ? src[j].photons - first
                                                                           : CACHE_DISPATCH_PHOTONS;
@@ -506,6 +561,8 @@ done:
     if (sparse) veil_ev_sparse_bind(NULL);
     glDeleteBuffers(5, buf);
     glDeleteBuffers(1, &medium_ubo);
+    glDeleteBuffers(1, &env_buf);
+    veil_env_table_free(&table);
     if (r != VEIL_OK) {
         glDeleteTextures(1, tex);
         *tex = 0;

@@ -25,7 +25,12 @@
  * the grid's box, E A / N each; a point or spot light: in a cone covering
  * the box, or the whole sphere from inside, I Omega / N each, a spot's
  * falloff applied per photon; emission: in a cell chosen with probability
- * p_k proportional to its emission weight, 4 pi V eps(x) / (p_k N)), are
+ * p_k proportional to its emission weight, 4 pi V eps(x) / (p_k N); the
+ * environment's rest: a texel block k of solid angle Omega_k with
+ * probability p_k proportional to its luminance times Omega_k, a direction
+ * uniform in it, a start uniform on the disc of area A = pi r^2 across it
+ * that covers the grid's bounding sphere (radius r), L_k Omega_k A /
+ * (p_k N) each), are
  * tracked by delta tracking against the cells' majorants (cache_bounds.comp),
  * and every piece of path of length l in a cell of volume V adds w l / V to
  * its fluence (the track-length estimator: E[sum of l] over photons is the
@@ -58,6 +63,10 @@ typedef struct veil_cache_settings {
     int cells;         /* along the grid's longest side (4..512) */
     uint32_t seed;     /* the same seed, medium and lights give the same cache, bit for bit */
     int emission;      /* 1: the medium's emission is a source (the cache carries all its light) */
+    int environment;   /* 1: the scene environment's rest is a source (scene/environment.h: the cache carries all
+                          its light; its bright part is the median cut's lights) */
+    size_t env_texels; /* its photon table's texels at most (0: VEIL_ENV_TABLE_TEXELS; a larger map is averaged
+                          over blocks) */
 } veil_cache_settings;
 
 typedef struct veil_cache_report {
@@ -72,7 +81,9 @@ typedef struct veil_cache_report {
     int cap;               /* a photon's step cap */
     double steps;          /* the steps a photon takes, as estimated from the cells' majorants */
     long long asked;       /* the photons the budget asked for (more than `photons`: the medium is thick) */
-    int too_thick;         /* 1: no cache (*tex 0): even VEIL_CACHE_MIN_PHOTONS would take over the budget */
+    int too_thick;         /* 1: even VEIL_CACHE_MIN_PHOTONS would take over the budget: no cache (*tex 0), or,
+                              with the environment's rest, its photons alone, each to its first scattering */
+    double env_rest[3];    /* the environment's rest a source: its integral over the sphere (W/m^2), else 0 */
     /* The energy account (core/shared.glsl.h), W per channel: [VEIL_CACHE_ENERGY_IN] the light that
      * scattered (or was emitted), [_OUT] what of it left the grid, [_ABSORBED] what was absorbed,
      * [_COLLISIONS] the collision estimator of the integral of sigma_t phi (W), [_TRACK] the track length

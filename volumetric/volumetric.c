@@ -390,6 +390,11 @@ uint64_t veil_volumetric_key(uint64_t ev_key, const veil_volumetric_desc* d)
         key = veil_hash_bytes(key, &d->cache.cells, sizeof d->cache.cells);
         key = veil_hash_bytes(key, &d->cache.seed, sizeof d->cache.seed);
         key = veil_hash_bytes(key, &d->cache.emission, sizeof d->cache.emission);
+        key = veil_hash_bytes(key, &d->cache.environment, sizeof d->cache.environment);
+        if (d->cache.environment) {
+            key = veil_hash_bytes(key, &s->environment.key, sizeof s->environment.key);
+            key = veil_hash_bytes(key, &d->cache.env_texels, sizeof d->cache.env_texels);
+        }
     }
     for (size_t i = 0; i < s->medium.source_count; ++i)
         if (s->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL)

@@ -476,6 +476,121 @@ static void floor_absorbs(veil_volumetric* d)
     veil_solid_free(&so);
 }
 
+/* 6. The environment's rest as a source: a map with a smooth sky and a bright disc (so that the clip takes
+ * its top off), turned and Z-up, over an absorbing fog box that is not a cube. Its photons start on a disc
+ * across their direction, from a table of texel blocks (scene/environment.h); the CPU samples the same map
+ * through its own distribution (veil_env_sample, the reference's), independently. Two integrals checked:
+ *  - what enters the grid (the account's "in": the environment's light counts from its start): the
+ *    integral of R(w) A(w) over directions, R the rest and A the box's area seen along w (the faces'
+ *    areas times |w . n|), by the CPU's Monte Carlo over R / pdf;
+ *  - the track length of the light not yet scattered (the account's track less its later part), which is
+ *    the integral over the box of its fluence: of R(w) exp(-sigma_t s) over directions and the box's
+ *    points, s the way from the point to the box's side towards w; the CPU samples w and a point.
+ * Both paired by group on the GPU side (5.5 standard errors of the groups' spread, as in 4) and the CPU's
+ * own standard error beside it in quadrature. A wrong frame, disc, block or weight moves either. The map
+ * is constant over blocks of 4 x 4 texels, so that the table's blocks of 4 (asked for by a small table)
+ * hold the same map as blocks of 1: the one CPU integral checks both. */
+static void environment_rest(veil_volumetric* d, int block)
+{
+    veil_error err = {0};
+    veil_source fog = fog_box();
+    const float lo[3] = {-1.0f, -0.5f, -1.5f}, hi[3] = {1.0f, 0.5f, 1.5f};
+    for (int a = 0; a < 3; ++a) fog.fog.bounds[0][a] = lo[a], fog.fog.bounds[1][a] = hi[a];
+    veil_scene s = {0};
+    const float sigma_s[3] = {0.5f, 0.35f, 0.2f}, sigma_a[3] = {0.1f, 0.2f, 0.3f};
+    for (int c = 0; c < 3; ++c) s.medium.sigma_s[c] = sigma_s[c], s.medium.sigma_a[c] = sigma_a[c];
+    s.medium.phase = (veil_phase){.type = VEIL_PHASE_HG, .g = 0.5f};
+    s.medium.sources = &fog;
+    s.medium.source_count = 1;
+    veil_multiple_defaults(&s.multiple);
+    veil_environment* e = &s.environment;
+    const int W = 96, H = 48;
+    e->present = 1, e->width = W, e->height = H, e->rotation_deg = 30.0f, e->up_z = 1;
+    e->rgb = malloc((size_t)W * H * 3 * sizeof *e->rgb);
+    for (int j = 0; e->rgb && j < H; ++j)
+        for (int i = 0; i < W; ++i) { /* constant over blocks of 4 x 4 texels: the same map in blocks of up to 4 */
+            double t = VEIL_PI * (j / 4 * 4 + 2) / H, p = 2.0 * VEIL_PI * (i / 4 * 4 + 2) / W;
+            double m[3] = {-sin(t) * cos(p), cos(t), -sin(t) * sin(p)};
+            int sun = m[0] * 0.6 + m[1] * 0.8 > cos(10.0 * VEIL_PI / 180.0);
+            float* x = e->rgb + 3 * ((size_t)j * W + i);
+            x[0] = sun ? 400.0f : (float)(0.3 + 0.2 * m[1] + 0.1 * m[0]);
+            x[1] = sun ? 380.0f : (float)(0.4 + 0.2 * m[1]);
+            x[2] = sun ? 300.0f : (float)(0.7 + 0.1 * m[1] - 0.1 * m[2]);
+        }
+    static const int rungs[1] = {8};
+    veil_env_make_cuts(e, 8, rungs, 1);
+    CHECK(e->rgb && veil_env_dist_make(e, &err) == VEIL_OK, "the map: %s", err.msg);
+    double rest[3], all[3];
+    veil_env_part_integral(e, 0, rest);
+    veil_env_integral(e, all);
+    CHECK(rest[1] < 0.5 * all[1] && rest[1] > 0.05 * all[1], "the clip takes the disc's top off: the rest %.4g of %.4g",
+          rest[1], all[1]);
+    GLuint opv[VEIL_MAX_OPV_TEXTURES] = {0};
+    /* the photons' table in blocks of block x block texels (a table smaller than the map asks for them) */
+    const size_t texels = (size_t)(W / block) * (size_t)(H / block);
+    veil_volumetric_desc vd = {.kind = VEIL_FIELD_CACHE,
+                               .medium = {.scene = &s, .lights = NULL, .light_count = 0, .opv = opv},
+                               .cache = {.photons = 1 << 18, .cells = 12, .seed = 17, .environment = 1,
+                                         .env_texels = texels}};
+    veil_volumetric_field f;
+    veil_volumetric_report rep;
+    CHECK(veil_volumetric_update(d, &vd, 500 + (uint64_t)block, &f, &rep, &err) == VEIL_OK, "%s", err.msg);
+    const veil_cache_report* c = &rep.cache;
+    CHECK(c->cut == 0 && c->misses == 0 && c->sources == 1 && c->photons > 0,
+          "the environment's cache: %u cut, %u misses, %d sources, %lld photons", c->cut, c->misses, c->sources,
+          c->photons);
+    /* the CPU's integrals, N samples: the area seen and, at a point uniform in the box, exp(-sigma_t s) */
+    enum { N = 1 << 20 };
+    const double area[3] = {(hi[1] - lo[1]) * (hi[2] - lo[2]), (hi[0] - lo[0]) * (hi[2] - lo[2]),
+                            (hi[0] - lo[0]) * (hi[1] - lo[1])};
+    const double vol = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+    double sum_in[3] = {0}, sq_in[3] = {0}, sum_tr[3] = {0}, sq_tr[3] = {0};
+    mc_state = 4242u;
+    for (int n = 0; n < N; ++n) {
+        double w[3], L[3];
+        double pdf = veil_env_sample(e, mc_rnd(), mc_rnd(), mc_rnd(), w);
+        veil_env_radiance(e, w, L);
+        double l = 0.2126 * L[0] + 0.7152 * L[1] + 0.0722 * L[2];
+        double keep = l > e->clip ? e->clip / l : 1.0;
+        double seen = fabs(w[0]) * area[0] + fabs(w[1]) * area[1] + fabs(w[2]) * area[2];
+        double x[3], s_up = INFINITY;
+        for (int a = 0; a < 3; ++a) {
+            x[a] = lo[a] + mc_rnd() * (hi[a] - lo[a]);
+            if (w[a] != 0.0) s_up = fmin(s_up, ((w[a] > 0.0 ? hi[a] : lo[a]) - x[a]) / w[a]);
+        }
+        for (int ch = 0; ch < 3; ++ch) {
+            double r = L[ch] * keep / pdf, v_in = r * seen, v_tr = r * vol * exp(-(sigma_s[ch] + sigma_a[ch]) * s_up);
+            sum_in[ch] += v_in, sq_in[ch] += v_in * v_in;
+            sum_tr[ch] += v_tr, sq_tr[ch] += v_tr * v_tr;
+        }
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+        double m_in = sum_in[ch] / N, m_tr = sum_tr[ch] / N;
+        double se_in_cpu = sqrt((sq_in[ch] / N - m_in * m_in) / (N - 1.0));
+        double se_tr_cpu = sqrt((sq_tr[ch] / N - m_tr * m_tr) / (N - 1.0));
+        const int k_in[1] = {VEIL_CACHE_ENERGY_IN}, k_tr[2] = {VEIL_CACHE_ENERGY_TRACK, VEIL_CACHE_ENERGY_LATER_TRACK};
+        const int k_bal[3] = {VEIL_CACHE_ENERGY_IN, VEIL_CACHE_ENERGY_OUT, VEIL_CACHE_ENERGY_ABSORBED};
+        const double one[1] = {1.0}, diff[2] = {1.0, -1.0}, bal_k[3] = {1.0, -1.0, -1.0};
+        double se_in, se_tr, se_bal;
+        double in = group_sum(c, 1, k_in, one, ch, &se_in);
+        double tr = group_sum(c, 2, k_tr, diff, ch, &se_tr);
+        double bal = group_sum(c, 3, k_bal, bal_k, ch, &se_bal);
+        double tol_in = 5.5 * sqrt(se_in * se_in + se_in_cpu * se_in_cpu);
+        double tol_tr = 5.5 * sqrt(se_tr * se_tr + se_tr_cpu * se_tr_cpu);
+        CHECK(fabs(in - m_in) <= tol_in, "environment (block %d), channel %d: %.6g W entered the grid, the CPU's "
+              "integral %.6g: off by %.3g > %.3g", block, ch, in, m_in, in - m_in, tol_in);
+        CHECK(fabs(tr - m_tr) <= tol_tr, "environment (block %d), channel %d: the unscattered light's track %.6g W m, "
+              "the CPU's integral %.6g: off by %.3g > %.3g", block, ch, tr, m_tr, tr - m_tr, tol_tr);
+        CHECK(fabs(bal) <= 5.5 * se_bal, "environment, channel %d: in - left - absorbed = %.3g > %.3g", ch, bal,
+              5.5 * se_bal);
+        CHECK(fabs(c->env_rest[ch] - rest[ch]) <= 1e-9 * rest[ch], "the report's rest %.9g, not %.9g", c->env_rest[ch],
+              rest[ch]);
+        printf("environment (block %d), channel %d: entered %.5g W (CPU %.5g, bound %.2g), unscattered track %.5g W m "
+               "(CPU %.5g, bound %.2g)\n", block, ch, in, m_in, tol_in, tr, m_tr, tol_tr);
+    }
+    veil_env_free(e);
+}
+
 static double image_mean(const float* rgba, int n, int stride)
 {
     double sum = 0.0;
@@ -585,6 +700,8 @@ int main(void)
     if (d) determinism(d);
     if (d) energy(d);
     if (d) floor_absorbs(d);
+    if (d) environment_rest(d, 1);
+    if (d) environment_rest(d, 4);
     veil_volumetric_destroy(d);
     no_double_count(gl);
     veil_gl_destroy(gl);

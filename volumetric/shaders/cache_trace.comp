@@ -1,9 +1,10 @@
 // veil — the light cache's photons (volumetric/cache.h): one invocation a
-// photon of one source (a sun, a point or spot light, or the medium's
-// emission), traced through the medium by delta tracking against the
-// cells' majorants, scoring the track-length estimator of the fluence and
+// photon of one source (a sun, a point or spot light, the medium's
+// emission, or the environment's rest), traced through the medium by
+// delta tracking against the cells' majorants, scoring the track-length estimator of the fluence and
 // its flux in every cell it crosses after its first scattering (from its
-// start for emission: the cache then carries emission's every order).
+// start for emission and the environment's rest: the cache then carries
+// their every order).
 //
 // Colour: one path for the three channels (spectral tracking, Kutz et al.
 // 2017, with probabilities from the history-aware average): at a tentative
@@ -139,6 +140,28 @@ void trace(uint n)
         int l = int(cb.source.y);
         if (int(med.lights[l].position.w) == VEIL_LIGHT_SPOT)
             w *= veil_spot_falloff(dot(dir, med.lights[l].direction.xyz), med.lights[l].direction.w, med.lights[l].color.w);
+    } else if (cb.source.x == uint(VEIL_CACHE_ENV)) {
+        // the environment's rest: a texel block by its CDF (binary search, as the emission's), a direction
+        // uniform in solid angle within it, a start on the disc across it that covers the grid's bounding
+        // sphere, upstream of it
+        float xi = rnd();
+        int a = 0, b = cb.dims.w - 1;
+        while (a < b) {
+            int m = (a + b) / 2;
+            if (uintBitsToFloat(emitters[2 * m].y) > xi) b = m; else a = m + 1;
+        }
+        int k = int(uintBitsToFloat(emitters[2 * a].x)), f = int(cb.src3.w);
+        int mw = int(cb.src1.w), mh = int(cb.src2.w), tw = (mw + f - 1) / f;
+        int bi = k % tw, bj = k / tw;
+        float phi = 2.0 * VEIL_PI * mix(float(bi * f), float(min((bi + 1) * f, mw)), rnd()) / float(mw);
+        float c0 = cos(VEIL_PI * float(bj * f) / float(mh)), c1 = cos(VEIL_PI * float(min((bj + 1) * f, mh)) / float(mh));
+        float ct = mix(c0, c1, rnd()), st = sqrt(max(1.0 - ct * ct, 0.0));
+        vec3 sky = normalize(-st * cos(phi) * cb.src1.xyz + ct * cb.src2.xyz - st * sin(phi) * cb.src3.xyz);
+        float r = cb.src0.w;
+        pos = cb.src0.xyz + sky * r + around(sky, 0.0, 2.0 * VEIL_PI * rnd()) * (r * sqrt(rnd()));
+        dir = -sky;
+        w *= uintBitsToFloat(emitters[2 * a + 1].xyz);
+        scored = true; // its light has not scattered yet: the cache carries every order of it
     } else {
         // an emitting cell by its CDF (binary search for the first entry above xi), uniform within it
         float xi = rnd();
@@ -159,7 +182,7 @@ void trace(uint n)
     if (!(max(w.r, max(w.g, w.b)) > 0.0)) return;
     vec2 span = box_hit(pos, dir, cb.origin.xyz, grid_hi, 0.0, INF);
     if (span.x >= span.y) return;
-    if (scored) acc_in = w; // the emission's light enters the account at its start
+    if (scored) acc_in = w; // the emission's (and the environment's) light enters the account at its start
     pos += dir * span.x;
     ivec3 c = clamp(ivec3(floor((pos - cb.origin.xyz) / h)), ivec3(0), cb.dims.xyz - 1);
     ivec3 step_dir = ivec3(sign(dir));
@@ -223,6 +246,7 @@ void trace(uint n)
         }
         if (xi < p_a + p_s) {
             w *= s_s / (maj * p_s);
+            if (cb.seed.w != 0u) break; // the first scattering ends it (flushed below; its later light is not kept)
             dir = scatter_hg(dir, g);
             step_dir = ivec3(sign(dir));
             if (!scored) acc_in = w;
