@@ -91,16 +91,32 @@ static void explain_lights(text* t, const veil_frame_plan* p)
     if (env->present) {
         int used = 0;
         const veil_env_cut* cut = veil_env_cut_for(env, veil_quality_rung_of(p->o.quality)->env_lights);
-        const int count = cut ? cut->count : 0;
-        for (int c = 0; c < count; ++c, ++k) used += k < p->light_count && !memcmp(&p->lights[k], &cut->lights[c], sizeof *cut->lights);
-        put(t, "light %-3zu  environment %s: %d directional light%s of its median cut into %d%s (%s)%s\n",
-            env->light_index, env->file ? env->file : "(a constant sky)", used, used == 1 ? "" : "s", cut ? cut->k : 0,
-            cut && cut->k < (env->lights > 0 ? env->lights : veil_quality_rung_of(p->o.quality)->env_lights)
-                ? ", the room the other lights leave" : "",
-            env->lights > 0 ? "its \"lights\"" : "the quality's", count == 0 ? "; black, lights nothing"
-                                                  : used < count ? "; the rest: no medium" : "");
+        const int count = cut ? (p->env_split ? cut->bright_count : cut->count) : 0;
+        const veil_light* lights = cut ? (p->env_split ? cut->bright : cut->lights) : NULL;
+        for (int c = 0; c < count; ++c, ++k) used += k < p->light_count && !memcmp(&p->lights[k], &lights[c], sizeof *lights);
+        const char* room = cut && cut->k < (env->lights > 0 ? env->lights : veil_quality_rung_of(p->o.quality)->env_lights)
+                               ? ", the room the other lights leave" : "";
+        const char* whose = env->lights > 0 ? "its \"lights\"" : "the quality's";
+        if (p->env_split) {
+            double all[3], bright[3];
+            veil_env_integral(env, all);
+            veil_env_part_integral(env, 1, bright);
+            const double lum_all = VEIL_LUM_R * all[0] + VEIL_LUM_G * all[1] + VEIL_LUM_B * all[2];
+            const double share = lum_all > 0.0 ? (VEIL_LUM_R * bright[0] + VEIL_LUM_G * bright[1] + VEIL_LUM_B * bright[2]) / lum_all : 0.0;
+            put(t, "light %-3zu  environment %s: its bright part (above %g times its mean luminance: %.3g %% of its "
+                   "light) as %d directional light%s of its median cut into at most %d%s (%s); the rest, %.3g %%, "
+                   "by the light cache's photons%s\n",
+                env->light_index, env->file ? env->file : "(a constant sky)", VEIL_ENV_CLIP, 100.0 * share, used,
+                used == 1 ? "" : "s", cut ? cut->k : 0, room, whose, 100.0 * (1.0 - share),
+                lum_all > 0.0 ? "" : "; black, lights nothing");
+        } else {
+            put(t, "light %-3zu  environment %s: %d directional light%s of its median cut into %d%s (%s)%s\n",
+                env->light_index, env->file ? env->file : "(a constant sky)", used, used == 1 ? "" : "s",
+                cut ? cut->k : 0, room, whose,
+                count == 0 ? "; black, lights nothing" : used < count ? "; the rest: no medium" : "");
+        }
         for (int c = 0; c < count; ++c) {
-            const veil_light* L = &cut->lights[c];
+            const veil_light* L = &lights[c];
             put(t, "           cut %-2d direction [%.9g, %.9g, %.9g] irradiance [%.9g, %.9g, %.9g]\n", c, L->direction[0],
                 L->direction[1], L->direction[2], L->color[0], L->color[1], L->color[2]);
         }

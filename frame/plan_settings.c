@@ -78,7 +78,7 @@ static int light_reaches(const veil_light* l, const veil_grid* g)
     return angle <= spread;
 }
 
-int veil_render_lights(const veil_scene* s, const veil_grid* g, int env_lights, veil_light* out)
+int veil_render_lights(const veil_scene* s, const veil_grid* g, int env_lights, int env_split, veil_light* out)
 {
     int n = 0;
     if (!g && count_fogs(s) == 0) return 0; /* no medium at all */
@@ -86,8 +86,10 @@ int veil_render_lights(const veil_scene* s, const veil_grid* g, int env_lights, 
         if (light_reaches(&s->lights[l], g)) out[n++] = s->lights[l];
     /* the environment as directional lights, after the scene's (scene/environment.h: the median cut) */
     const veil_env_cut* cut = veil_env_cut_for(&s->environment, env_lights);
-    for (int l = 0; cut && l < cut->count && n < VEIL_MAX_LIGHTS; ++l)
-        if (light_reaches(&cut->lights[l], g)) out[n++] = cut->lights[l];
+    const int count = cut ? (env_split ? cut->bright_count : cut->count) : 0;
+    const veil_light* lights = cut ? (env_split ? cut->bright : cut->lights) : NULL;
+    for (int l = 0; l < count && n < VEIL_MAX_LIGHTS; ++l)
+        if (light_reaches(&lights[l], g)) out[n++] = lights[l];
     return n;
 }
 
@@ -137,12 +139,26 @@ static veil_field_kind field_kind(const veil_multiple* m)
     return escape ? VEIL_FIELD_ESCAPE : VEIL_FIELD_FLUENCE;
 }
 
+int veil_env_split(const veil_scene* s)
+{
+    return s->environment.present && !s->environment.remainder_lights && field_kind(&s->multiple) == VEIL_FIELD_CACHE;
+}
+
 void veil_frame_plan_volume(veil_frame_plan* p, const veil_grid* g, int sparse, const veil_light* emission,
                             int n_emission)
 {
     p->grid = g;
     p->sparse = g ? sparse : 0;
-    p->light_count = veil_render_lights(p->scene, g, veil_quality_rung_of(p->o.quality)->env_lights, p->lights);
+    p->env_split = veil_env_split(p->scene);
+    if (p->env_split) { /* and only where the cache has a grid to hold it (a medium, fogs not too wide) */
+        veil_volumetric_desc probe = {.kind = VEIL_FIELD_CACHE, .medium = {.scene = p->scene, .grid = g},
+                                      .cache = {.cells = 8}};
+        float lo[3], h;
+        int dims[3];
+        p->env_split = veil_volumetric_grid(&probe, lo, &h, dims);
+    }
+    p->light_count =
+        veil_render_lights(p->scene, g, veil_quality_rung_of(p->o.quality)->env_lights, p->env_split, p->lights);
     const veil_multiple* m = &p->scene->multiple;
     /* the light cache carries all of the emission's light (volume/cache.h): it needs no emission lights */
     const int cache = field_kind(m) == VEIL_FIELD_CACHE;
@@ -173,7 +189,8 @@ void veil_frame_plan_volume(veil_frame_plan* p, const veil_grid* g, int sparse, 
         .cache = {.photons = m->cache_photons > 0 ? m->cache_photons : q->cache_photons,
                   .cells = m->cache_cells > 0 ? m->cache_cells : q->cache_cells,
                   .seed = m->cache_seed,
-                  .emission = cache && p->glows}};
+                  .emission = cache && p->glows,
+                  .environment = p->env_split}};
 }
 
 veil_result veil_frame_sparse_estimate(const veil_frame_plan* p, const veil_scene_volume* v, veil_sparse_work* w,

@@ -341,10 +341,12 @@ static void propagate_settle(veil_frame* f, const veil_stage_report* rep)
 
 /* ---- volumetric: multiply scattered light, view-independent ----------- */
 
-/* Sources of the volumetric field: the lights, and for the light cache the medium's emission. */
+/* Sources of the volumetric field: the lights, and for the light cache the medium's emission and the
+ * environment's rest. */
 static int volumetric_sources(const veil_frame_plan* p)
 {
-    return p->light_count + (p->volumetric.kind == VEIL_FIELD_CACHE && p->volumetric.cache.emission);
+    const int cache = p->volumetric.kind == VEIL_FIELD_CACHE;
+    return p->light_count + (cache && p->volumetric.cache.emission) + (cache && p->volumetric.cache.environment);
 }
 
 static uint64_t volumetric_key(const veil_frame_plan* p)
@@ -397,7 +399,10 @@ static veil_stage_status volumetric_decide(const veil_frame_plan* p, int kept, c
     else if (cache)
         say(w, n, "key %016llx: the light cache, %lld photons from %d source%s%s, %dx%dx%d cells of %.4g m: "
             "view-independent, kept for the next frames", key, d->cache.photons, volumetric_sources(p),
-            volumetric_sources(p) == 1 ? "" : "s", d->cache.emission ? " (the emission one of them)" : "",
+            volumetric_sources(p) == 1 ? "" : "s",
+            d->cache.emission && d->cache.environment ? " (the emission and the environment's rest two of them)"
+            : d->cache.emission                       ? " (the emission one of them)"
+            : d->cache.environment                    ? " (the environment's rest one of them)" : "",
             dims[0], dims[1], dims[2], cell);
     else if (escape)
         say(w, n, "key %016llx: the octaves' escape field, %dx%dx%d cells of %.4g m: view- and light-independent, "
@@ -428,6 +433,11 @@ static veil_result volumetric_build(veil_frame* f, veil_stage_report* rep, veil_
             "photon: %d photons would take over %d x the budget's %lld steps); the march's octaves, gated by the "
             "legs, stand in for it",
             vr.cache.steps, VEIL_CACHE_MIN_PHOTONS, VEIL_CACHE_STEPS_PER_PHOTON, d.cache.photons);
+    } else if (!vr.skipped && vr.cache.too_thick) {
+        say(rep->why, sizeof rep->why, "the light cache holds the environment's rest alone, %lld photons each to its "
+            "first scattering, %dx%dx%d cells of %.4g m: the medium is too thick for more (about %.3g steps a photon); "
+            "the march's octaves, gated by the legs, stand in for the higher orders", vr.cache.photons,
+            vr.cache.dims[0], vr.cache.dims[1], vr.cache.dims[2], (double)vr.cache.cell, vr.cache.steps);
     } else if (vr.skipped) { /* decide() found a grid; the module did not: say so rather than hide it */
         rep->status = VEIL_STAGE_SKIPPED;
         say(rep->why, sizeof rep->why, "no grid was made for the field");

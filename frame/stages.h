@@ -95,8 +95,14 @@ const veil_quality_rung* veil_quality_rung_of(veil_quality q); /* UNSET: the def
 
 /* The lights of s that add light inside the box of g (NULL: fog only, no
  * box), in scene order, into out (VEIL_MAX_LIGHTS): zero colour never
- * does; a spot whose outer cone misses the box's bounding sphere does not. */
-int veil_render_lights(const veil_scene* s, const veil_grid* g, int env_lights, veil_light* out);
+ * does; a spot whose outer cone misses the box's bounding sphere does not.
+ * Then an environment's median cut into env_lights: of the whole map, or
+ * with env_split, of its bright part alone (the light cache carries the
+ * rest: scene/environment.h). */
+int veil_render_lights(const veil_scene* s, const veil_grid* g, int env_lights, int env_split, veil_light* out);
+/* Whether s's environment is split (its bright part the cut's, its rest the light cache's): s has one, its
+ * "remainder" is "cache" and the light cache is the volumetric method (the plan also asks for a grid). */
+int veil_env_split(const veil_scene* s);
 
 /* A frame's plan: every setting resolved once, read by every row. */
 typedef struct veil_frame_plan {
@@ -118,6 +124,7 @@ typedef struct veil_frame_plan {
     /* veil_frame_plan_volume(): the lights that add light (the scene's, then the emission's) */
     veil_light lights[VEIL_MAX_LIGHTS];
     int light_count, emission_lights;
+    int env_split;                  /* the environment's cut is of its bright part; the cache carries the rest */
     int glows;                      /* a voxelised source emits (the light cache traces its light) */
     veil_opv_params opv;            /* the propagation's method and parameters */
     /* the lights in the grid's index space, and the suns that get a light-space grid (as planned

@@ -74,6 +74,8 @@ static veil_result program_for(veil_march* m, const veil_lit_medium* lm, const v
     if (light_list) { /* and the field with them (march.comp says why not apart) */
         const int field = (int)u->diffusion[3];
         append(want.defines, cap, "#define VEIL_MARCH_FIELD %d\n#define VEIL_MARCH_GATHER %d\n", field, u->march[1] > 0.0f, 0);
+        if (field == VEIL_FIELD_CACHE && u->octave[3] > 1.0f) /* a cache of the first scattering alone: octaves too */
+            append(want.defines, cap, "#define VEIL_MARCH_OCTAVES 1\n", 0, 0, 0), strcat(name, "octaves, ");
         snprintf(name + strlen(name), sizeof name - strlen(name), "field %d%s, ", field, u->march[1] > 0.0f ? ", gathered" : "");
         append(want.defines, cap, "#define VEIL_LIGHT_LIST", 0, 0, 0);
         for (int l = 0; l < mu->counts[0] && l < VEIL_MAX_LIGHTS; ++l)
@@ -179,7 +181,7 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* u,
     /* the octaves: asked for, or in place of a light cache that could not be made (a fog box too wide for
      * its grid, a medium too thick for photons): gated by the legs then (no escape field) */
     const int no_cache = ms->volumetric_method == VEIL_VOLUMETRIC_CACHE &&
-                         !(d->field && d->field->texture && d->field->kind == VEIL_FIELD_CACHE);
+                         !(d->field && d->field->texture && d->field->kind == VEIL_FIELD_CACHE && !d->field->first_only);
     if (ms->volumetric && (ms->volumetric_method == VEIL_VOLUMETRIC_OCTAVE || no_cache) && ms->octaves > 1) {
         u->octave[0] = ms->octave_a, u->octave[1] = ms->octave_b, u->octave[2] = ms->octave_c;
         u->octave[3] = (float)ms->octaves;

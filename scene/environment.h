@@ -56,9 +56,10 @@
 /* The split, where the light cache carries the remainder (frame/stages.h, docs/accuracy.md): a texel's
  * luminance above VEIL_ENV_CLIP times the map's mean (over the sphere) is its bright part, the median cut's;
  * the rest, at most that luminance, is the cache's photons'. A region of the bright part under
- * VEIL_ENV_POINT_DEG across is one light (a sun), not split further. */
+ * VEIL_ENV_POINT_DEG across is one light (a sun), not split further: a 6-degree disc as 4 lights gave no
+ * better images than as 1 (docs/accuracy.md), and each light costs a propagation. */
 #define VEIL_ENV_CLIP 8.0
-#define VEIL_ENV_POINT_DEG 4.0
+#define VEIL_ENV_POINT_DEG 8.0
 /* The rest's photon table holds at most this many texels (a larger map is averaged over blocks of texels) */
 #define VEIL_ENV_TABLE_TEXELS ((size_t)1 << 19)
 

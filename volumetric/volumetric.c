@@ -209,6 +209,7 @@ static veil_result update_cache(veil_volumetric* d, const veil_volumetric_desc* 
     d->field.texture = d->phi;
     d->field.depth = dims[2];
     d->field.kind = VEIL_FIELD_CACHE;
+    d->field.first_only = d->cache_rep.too_thick;
     d->keyed = 1, d->key = key;
     *field = d->field;
     memcpy(rep->dims, dims, sizeof rep->dims);

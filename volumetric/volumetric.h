@@ -57,6 +57,8 @@ typedef struct veil_volumetric_field {
     veil_field_kind kind; /* VEIL_FIELD_NONE when texture is 0 */
     float tex_min[3];     /* texture coordinates are (x - tex_min) * tex_inv */
     float tex_inv[3];
+    int first_only;       /* the light cache of a medium too thick for photons: the environment's rest alone, to its
+                             first scattering (volumetric/cache.h); the march's octaves stand in for the higher orders */
 } veil_volumetric_field;
 
 /* What the stage is asked to build (frame/ decides; none of it is the camera's). */

@@ -3,6 +3,7 @@
 
     /usr/bin/python3 bench/peers_cycles/environment.py [--scenes smoke,cloud] [--skies constant,hdri]
         [--size 160x120] [--ref-spp 2048] [--cycles-spp 1024] [--lights 1,2,4,8,16] [--split 8,16] [--no-cycles]
+        [--remainder cache,lights] [--quality default,high,max] [--g G] [--ref FOLDER] [--runs 3]
         [--veil build/veil] [--out docs/results]
 
 For each scene (the shared smoke of bench/regress.py; the generated cloud of cloud.py) under each sky:
@@ -16,11 +17,15 @@ with the scene's own lights removed, it runs
      exact T x environment seen through it, the same in both), where T < 0.99: the mean bias with its
      standard error (the reference's noise) and the RMS difference on 4x4 blocks beside the
      reference's own noise there;
-  2. `veil render` with the environment as K directional lights (median cut, scene/environment.h) for
-     each K of --lights: time (median of --runs whole runs) and error against the reference, measured as
-     Cycles' is (the scattered light where T < 0.99: mean bias, RMS on 4x4 blocks);
-  3. for each K of --split, the two errors apart: the cut's (the reference of its K lights against the
-     reference of the map) and the GPU pipeline's (veil render against the reference of the K lights).
+  2. `veil render` for each K of --lights, each "remainder" of --remainder (cache: the median cut of the
+     map's bright part into at most K lights, the rest by the light cache; lights: the whole map as K
+     directional lights, scene/environment.h) and each --quality: time (median of --runs whole runs) and
+     error against the reference, measured as Cycles' is (the scattered light where T < 0.99: mean bias,
+     RMS on 4x4 blocks);
+  3. for each K of --split (remainder lights, default quality), the two errors apart: the cut's (the
+     reference of its K lights against the reference of the map) and the GPU pipeline's (veil render
+     against the reference of the K lights).
+--g replaces the medium's phase function by HG(g); --ref keeps the references in a folder and reuses them.
 Results: OUT/peers_cycles_environment.md. Needs blender (unless --no-cycles), numpy and OpenImageIO for
 /usr/bin/python3."""
 import argparse, json, os, statistics, sys, tempfile, time
@@ -175,6 +180,12 @@ def main():
     ap.add_argument("--lights", default="1,2,4,8,16")
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--split", default="8,16", help="the Ks whose error is taken apart (empty: none)")
+    ap.add_argument("--remainder", default="cache,lights",
+                    help="the environment's \"remainder\" settings to measure: cache (the median cut of its bright "
+                         "part, the rest by the light cache's photons), lights (the whole map as the cut's lights)")
+    ap.add_argument("--quality", default="default", help="veil render's --quality (a comma list)")
+    ap.add_argument("--ref", default=None, help="a folder to keep the references in and reuse them from")
+    ap.add_argument("--g", type=float, default=None, help="the medium's phase function: HG of this g instead")
     ap.add_argument("--no-cycles", action="store_true")
     ap.add_argument("--veil", default=os.path.join(ROOT, "build", "veil"))
     ap.add_argument("--blender", default="blender")
@@ -193,15 +204,19 @@ def main():
     for name in a.scenes.split(","):
         for sky in a.skies.split(","):
             sc = smoke_scene(w, h) if name == "smoke" else cloud_scene(w, h)
+            if a.g is not None:
+                sc["medium"]["phase"] = {"type": "hg", "g": a.g}
             env = {"type": "environment", "color": SKY} if sky == "constant" else {"type": "environment", "file": hdri}
             sc["lights"] = [env]
             sc.pop("background", None)
             scene = os.path.join(tmp, "%s_%s.json" % (name, sky))
             with open(scene, "w") as f:
                 json.dump(sc, f, indent=1)
-            ref = os.path.join(tmp, "%s_%s_ref.exr" % (name, sky))
+            ref = os.path.join(a.ref or tmp, "%s_%s_%dx%d_%d%s_ref.exr" % (
+                name, sky, w, h, a.ref_spp, "" if a.g is None else "_g%g" % a.g))
             t0 = time.perf_counter()
-            peers.run([a.veil, "reference", scene, "-o", ref, "--spp", str(a.ref_spp), "--seed", "7"])
+            if not (a.ref and os.path.exists(ref)):
+                peers.run([a.veil, "reference", scene, "-o", ref, "--spp", str(a.ref_spp), "--seed", "7"])
             t_ref = time.perf_counter() - t0
             lookup = env_lookup(None if sky == "constant" else hdri)
             if not a.no_cycles:
@@ -215,23 +230,25 @@ def main():
                 cyc_rows.append("| %s | %s | %d | %+.3f %% | %.3f %% | %.2f %% | %.2f %% | %.1f s | %.1f s |" % (
                     name, sky, n, 100 * bias, 100 * bias_se, 100 * rel4, 100 * noise4, t_ref, t_cyc))
                 print(cyc_rows[-1], flush=True)
-            for k in (int(v) for v in a.lights.split(",")):
+            for k, rem, q in ((int(v), r, q) for v in a.lights.split(",") for r in a.remainder.split(",")
+                              for q in a.quality.split(",")):
                 sk = json.loads(json.dumps(sc))
                 sk["lights"][0]["lights"] = k
-                sp = os.path.join(tmp, "%s_%s_%d.json" % (name, sky, k))
+                sk["lights"][0]["remainder"] = rem
+                sp = os.path.join(tmp, "%s_%s_%d_%s.json" % (name, sky, k, rem))
                 with open(sp, "w") as f:
                     json.dump(sk, f, indent=1)
                 img = os.path.join(tmp, "gpu.exr")
                 times = []
                 for _ in range(a.runs):
                     t0 = time.perf_counter()
-                    peers.run([a.veil, "render", sp, "-o", img])
+                    peers.run([a.veil, "render", sp, "-o", img, "--quality", q])
                     times.append(time.perf_counter() - t0)
                 n, bias, bias_se, rel4, noise4 = cycles_vs_reference(ref, img, lookup, sc, w, h)
-                if str(k) in a.split.split(","):
+                if str(k) in a.split.split(",") and rem == "lights" and q == "default":
                     split_rows.append(split(a, sc, sp, ref, img, lookup, w, h, name, sky, k, tmp))
-                gpu_rows.append("| %s | %s | %d | %.2f s | %+.2f %% | %.2f %% | %.2f %% |" % (
-                    name, sky, k, statistics.median(times), 100 * bias, 100 * rel4, 100 * noise4))
+                gpu_rows.append("| %s | %s | %s | %d | %s | %.2f s | %+.2f %% | %.2f %% | %.2f %% |" % (
+                    name, sky, rem, k, q, statistics.median(times), 100 * bias, 100 * rel4, 100 * noise4))
                 print(gpu_rows[-1], flush=True)
     if cyc_rows:
         lines += ["Cycles against the reference: the light the medium scattered (each image less the exact T x "
@@ -239,11 +256,13 @@ def main():
                   "noise alone, the 4x4 RMS difference holds both noises.", "",
                   "| scene | sky | pixels | mean bias | its se | RMS 4x4 | reference noise 4x4 | reference | Cycles |",
                   "|---|---|---:|---:|---:|---:|---:|---:|---:|"] + cyc_rows + [""]
-    lines += ["`veil render` (default quality) against the reference, measured as Cycles is: the light the medium "
-              "scattered (the image less the reference's exact T x environment) where T < 0.99; time a median of %d "
-              "whole runs (process start, GL context and every stage included)." % a.runs, "",
-              "| scene | sky | lights K | time | mean bias | RMS 4x4 | reference noise 4x4 |",
-              "|---|---|---:|---:|---:|---:|---:|"]
+    lines += ["`veil render` against the reference, measured as Cycles is: the light the medium scattered (the "
+              "image less the reference's exact T x environment) where T < 0.99; time a median of %d whole runs "
+              "(process start, GL context and every stage included). Remainder `cache`: the median cut of the "
+              "map's bright part into at most K lights, the rest by the light cache's photons; `lights`: the "
+              "whole map as K lights." % a.runs, "",
+              "| scene | sky | remainder | lights K | quality | time | mean bias | RMS 4x4 | reference noise 4x4 |",
+              "|---|---|---|---:|---|---:|---:|---:|---:|"]
     lines += gpu_rows + [""]
     if split_rows:
         lines += ["K = %s taken apart: the cut (the reference of its K directional lights against the reference of "

@@ -70,7 +70,11 @@
 #ifdef VEIL_MARCH_FIELD
 #define MARCH_FIELD_IS(kind) (VEIL_MARCH_FIELD == (kind))
 #define MARCH_GATHER (VEIL_MARCH_GATHER != 0)
+#ifdef VEIL_MARCH_OCTAVES /* a cache of the environment's first scattering alone (render/march.c): octaves beside it */
+#define MARCH_CACHE_ONLY 0
+#else
 #define MARCH_CACHE_ONLY (VEIL_MARCH_FIELD == VEIL_FIELD_CACHE) /* no escape field, no octaves */
+#endif
 #else
 #define MARCH_FIELD_IS(kind) (u.diffusion.w == float(kind))
 #define MARCH_GATHER (u.march.y > 0.0)

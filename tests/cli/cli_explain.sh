@@ -19,9 +19,20 @@ grep -q '^render     every frame: runs' "$tmp/plan.txt" || fail "no render plan"
 [ -z "$(ls "$tmp" | grep -v plan.txt)" ] || fail "explain wrote files: $(ls "$tmp")"
 ok
 
-# an environment light: its median cut into the quality rung's count (draft 4, default 8, high 16), or
-# into its own "lights", at most the room the scene's other lights leave
-sed 's/"lights": \[/"lights": [{"type": "environment", "color": [0.2, 0.3, 0.5]},/' "$scenes/demo.json" > "$tmp/sky.json"
+# an environment light: by default its bright part is the median cut's and the light cache's photons carry
+# the rest; a constant sky has no bright part, so it adds no light to propagate
+sed 's/"lights": \[/"lights": [{"type": "environment", "color": [0.2, 0.3, 0.5]},/' "$scenes/demo.json" > "$tmp/rest.json"
+"$veil" render "$tmp/rest.json" --explain > "$tmp/env.txt" 2>&1 || fail "explain, rest: $(cat "$tmp/env.txt")"
+grep -q "^light 0    environment (a constant sky): its bright part (above 8 times its mean luminance: 0 % of its light) as 0 directional lights of its median cut into at most 8 (the quality's); the rest, 100 %, by the light cache's photons" "$tmp/env.txt" ||
+  fail "the split not explained: $(cat "$tmp/env.txt")"
+grep -q "^propagate  frame 0: runs, 3 lights" "$tmp/env.txt" || fail "the constant sky's rest propagated: $(cat "$tmp/env.txt")"
+grep -q "^volumetric frame 0: runs, .* from 4 sources (the environment's rest one of them)" "$tmp/env.txt" ||
+  fail "the cache does not carry the rest: $(cat "$tmp/env.txt")"
+ok
+
+# "remainder": "lights": the whole map as its median cut into the quality rung's count (draft 4, default
+# 8, high 16), or into its own "lights", at most the room the scene's other lights leave
+sed 's/"lights": \[/"lights": [{"type": "environment", "color": [0.2, 0.3, 0.5], "remainder": "lights"},/' "$scenes/demo.json" > "$tmp/sky.json"
 for q in draft:4:3 default:8:3 high:13:3; do
   IFS=: read -r rung k others <<< "$q"
   "$veil" render "$tmp/sky.json" --explain --quality "$rung" > "$tmp/env.txt" 2>&1 || fail "explain, sky: $(cat "$tmp/env.txt")"
@@ -31,7 +42,7 @@ for q in draft:4:3 default:8:3 high:13:3; do
   [ "$(grep -c '^           cut ' "$tmp/env.txt")" = "$k" ] || fail "quality $rung: the cut's $k lights not listed"
 done
 grep -q "into 13, the room the other lights leave (the quality's)" "$tmp/env.txt" || fail "room not said: $(cat "$tmp/env.txt")"
-sed 's/"color": \[0.2, 0.3, 0.5\]}/"color": [0.2, 0.3, 0.5], "lights": 2}/' "$tmp/sky.json" > "$tmp/sky2.json"
+sed 's/"remainder": "lights"}/"remainder": "lights", "lights": 2}/' "$tmp/sky.json" > "$tmp/sky2.json"
 "$veil" render "$tmp/sky2.json" --explain --quality high > "$tmp/env.txt" 2>&1 || fail "explain, sky 2: $(cat "$tmp/env.txt")"
 grep -q "median cut into 2 (its \"lights\")" "$tmp/env.txt" || fail "the scene's lights 2 not kept: $(cat "$tmp/env.txt")"
 ok

@@ -2,9 +2,14 @@
  *  - seen behind the medium: with no medium every pixel is the map's radiance along its ray (the march
  *    adds T x radiance with T = 1: one float rounding of the double lookup, 2^-24 relative); a scene
  *    "background" is seen instead when it gives one;
- *  - lighting the medium: a frame with an environment equals, bit for bit, the frame whose lights are
- *    the environment's median cut written out as directional lights (its "background" black, so that
- *    only the lights differ): the pipeline carries it as those lights and nothing else. */
+ *  - lighting the medium, "remainder": "lights": a frame with an environment equals, bit for bit, the
+ *    frame whose lights are the environment's median cut written out as directional lights (its
+ *    "background" black, so that only the lights differ): the pipeline carries it as those lights and
+ *    nothing else;
+ *  - by default (the light cache the volumetric method), the cut is of the bright part alone and the
+ *    cache carries the rest: a constant sky has no bright part, so no light is propagated and the cache
+ *    has one source, the environment's, whose light alone lights the medium (the cache's photons
+ *    themselves: tests/volumetric/test_cache.c; the bright cut: tests/scene/test_environment.c). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -105,7 +110,8 @@ static void test_lights(veil_renderer* r)
     snprintf(json, sizeof json,
              "{\"camera\": {\"position\": [0, 0.6, 4.2], \"look_at\": [0, 0, 0], \"fov_y_deg\": 40, \"width\": %d,"
              " \"height\": %d}, %s, \"lights\": [{\"type\": \"point\", \"position\": [-0.9, 0.1, 0.3], \"intensity\": [6, 3, 1]},"
-             " {\"type\": \"environment\", \"color\": [0.4, 0.5, 0.7], \"lights\": 6}]}", W, H, body);
+             " {\"type\": \"environment\", \"color\": [0.4, 0.5, 0.7], \"lights\": 6, \"remainder\": \"lights\"}]}",
+             W, H, body);
     veil_scene a, b;
     if (!parse(json, &a)) return;
     const veil_env_cut* cut = veil_env_cut_for(&a.environment, 8); /* its "lights": 6, whatever the rung */
@@ -152,6 +158,37 @@ static void test_lights(veil_renderer* r)
     veil_scene_free(&b);
 }
 
+/* The default split: the plan, the stages' reports and light where there is nothing else to light. */
+static void test_split(veil_renderer* r)
+{
+    static const char* const body =
+        "\"medium\": {\"sigma_a\": [0.1, 0.1, 0.1], \"sigma_s\": [1.4, 1.5, 1.6], \"max_resolution\": 40,"
+        " \"sources\": [{\"type\": \"rbf_random\", \"count\": 60, \"seed\": 7, \"bounds\": [[-1.2, -0.4, -0.6],"
+        " [1.2, 0.5, 0.6]], \"radius\": [0.1, 0.3], \"amplitude\": [0.3, 1.0]}]}, \"background\": {\"color\": [0, 0, 0]}";
+    char json[2048];
+    snprintf(json, sizeof json,
+             "{\"camera\": {\"position\": [0, 0.6, 4.2], \"look_at\": [0, 0, 0], \"fov_y_deg\": 40, \"width\": %d,"
+             " \"height\": %d}, %s, \"lights\": [{\"type\": \"environment\", \"color\": [0.4, 0.5, 0.7]}]}", W, H, body);
+    veil_scene a;
+    if (!parse(json, &a)) return;
+    veil_image_set im = {0};
+    veil_render_stats st = {0};
+    veil_error err = {0};
+    const veil_render_opts o = {.width = W, .height = H};
+    CHECK(veil_render_scene_images(r, &a, &o, &im, &st, &err) == VEIL_OK, "render: %s", err.msg);
+    if (im.rgba) {
+        double peak = 0.0;
+        for (size_t i = 0; i < (size_t)W * H; ++i) peak = fmax(peak, im.rgba[4 * i + 1]);
+        CHECK(peak > 0.01, "the sky's rest lit nothing (peak %g)", peak);
+        CHECK(strstr(st.stage[VEIL_STAGE_PROPAGATE].why, "no light reaches") != NULL,
+              "a constant sky propagates no light: %s", st.stage[VEIL_STAGE_PROPAGATE].why);
+        CHECK(strstr(st.stage[VEIL_STAGE_VOLUMETRIC].why, "from 1 source") != NULL,
+              "the cache has the environment's rest as its one source: %s", st.stage[VEIL_STAGE_VOLUMETRIC].why);
+    }
+    veil_image_set_free(&im);
+    veil_scene_free(&a);
+}
+
 int main(void)
 {
     veil_gl* gl = check_gpu_or_skip();
@@ -161,6 +198,7 @@ int main(void)
     if (r) {
         test_behind(r);
         test_lights(r);
+        test_split(r);
         veil_renderer_destroy(r);
     }
     veil_gl_destroy(gl);
