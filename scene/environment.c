@@ -120,8 +120,19 @@ typedef struct {
     const float* rgb; /* w * h * 3 */
     float one[3];     /* a constant sky's colour (rgb NULL) */
     env_part part;    /* the whole map, or its bright part or its rest above and below `clip` */
-    double clip;      /* the split's luminance (veil_env_split) */
+    double clip;      /* the split's luminance (veil_environment.clip) */
+    double* dw;       /* each row's texel solid angle (h values; NULL: computed at each use) */
 } env_map;
+
+/* m's rows' solid angles, computed once (a cut walks the map's texels several times); NULL when out of
+ * memory, which only makes it slower. */
+static void rows_made(env_map* m)
+{
+    m->dw = malloc((size_t)m->h * sizeof *m->dw);
+    for (int j = 0; m->dw && j < m->h; ++j) m->dw[j] = veil_env_texel_solid_angle(m->w, m->h, j);
+}
+
+static double row_dw(const env_map* m, int j) { return m->dw ? m->dw[j] : veil_env_texel_solid_angle(m->w, m->h, j); }
 
 /* The radiance t split at luminance clip: the rest is t scaled down to luminance clip where it is above it
  * (its colour kept), the bright part what that took away. */
@@ -142,7 +153,7 @@ static double texel_energy(const env_map* m, int i, int j)
 {
     double c[3];
     map_texel(m, i, j, c);
-    return luminance(c) * veil_env_texel_solid_angle(m->w, m->h, j);
+    return luminance(c) * row_dw(m, j);
 }
 
 static double region_energy(const env_map* m, int i0, int i1, int j0, int j1)
@@ -192,7 +203,7 @@ static int region_light(const env_map* m, const veil_environment* e, const env_r
 {
     double c[3] = {0, 0, 0}, d[3] = {0, 0, 0};
     for (int j = r->j0; j < r->j1; ++j) {
-        double dw = veil_env_texel_solid_angle(m->w, m->h, j);
+        double dw = row_dw(m, j);
         double ct = cos(ENV_PI * (j + 0.5) / m->h);
         for (int i = r->i0; i < r->i1; ++i) {
             double rgb[3], dir[3];
@@ -241,38 +252,46 @@ static double region_extent(const env_map* m, const env_region* r)
 
 /* The median cut of m's part (the whole map, or its bright part: regions shrunk to their lit texels, and
  * one under VEIL_ENV_POINT_DEG across is not split: it is a sun already). */
-static int median_cut(const veil_environment* e, env_part part, int max, veil_light* out)
+static int cut_regions(const veil_environment* e, const env_map* m, int max, veil_light* out)
 {
-    if (!e || !e->present || !e->rgb || max <= 0) return 0;
-    env_map m = {e->width, e->height, e->rgb, {0, 0, 0}, part, e->clip};
-    if (e->width == 1 && e->height == 1) { /* a constant sky: cut as a 64 x 32 map of itself */
-        m.w = 64, m.h = 32, m.rgb = NULL;
-        memcpy(m.one, e->rgb, sizeof m.one);
-    }
-    const int shrink = part == PART_BRIGHT;
+    const int shrink = m->part == PART_BRIGHT;
     env_region regions[VEIL_MAX_LIGHTS];
     if (max > VEIL_MAX_LIGHTS) max = VEIL_MAX_LIGHTS;
     int n = 1;
-    regions[0] = (env_region){0, m.w, 0, m.h, region_energy(&m, 0, m.w, 0, m.h)};
-    if (shrink && !lit_box(&m, &regions[0], &regions[0])) return 0;
+    regions[0] = (env_region){0, m->w, 0, m->h, region_energy(m, 0, m->w, 0, m->h)};
+    if (shrink && !lit_box(m, &regions[0], &regions[0])) return 0;
     const double point = VEIL_ENV_POINT_DEG * (ENV_PI / 180.0);
     while (n < max) {
         int pick = -1;
         for (int r = 0; r < n; ++r) /* the region carrying the most light that can still be split */
             if ((regions[r].i1 - regions[r].i0 > 1 || regions[r].j1 - regions[r].j0 > 1) &&
-                !(shrink && region_extent(&m, &regions[r]) <= point) &&
+                !(shrink && region_extent(m, &regions[r]) <= point) &&
                 (pick < 0 || regions[r].energy > regions[pick].energy))
                 pick = r;
         if (pick < 0 || !(regions[pick].energy > 0.0)) break;
         env_region a, b;
-        if (!split(&m, &regions[pick], &a, &b)) break;
+        if (!split(m, &regions[pick], &a, &b)) break;
         /* (a lit box's edges are lit, so both halves have light; were one dark, the cut stops there) */
-        if (shrink && (!lit_box(&m, &a, &a) || !lit_box(&m, &b, &b))) break;
+        if (shrink && (!lit_box(m, &a, &a) || !lit_box(m, &b, &b))) break;
         regions[pick] = a;
         regions[n++] = b;
     }
     int lights = 0;
-    for (int r = 0; r < n; ++r) lights += region_light(&m, e, &regions[r], &out[lights]);
+    for (int r = 0; r < n; ++r) lights += region_light(m, e, &regions[r], &out[lights]);
+    return lights;
+}
+
+static int median_cut(const veil_environment* e, env_part part, int max, veil_light* out)
+{
+    if (!e || !e->present || !e->rgb || max <= 0) return 0;
+    env_map m = {e->width, e->height, e->rgb, {0, 0, 0}, part, e->clip, NULL};
+    if (e->width == 1 && e->height == 1) { /* a constant sky: cut as a 64 x 32 map of itself */
+        m.w = 64, m.h = 32, m.rgb = NULL;
+        memcpy(m.one, e->rgb, sizeof m.one);
+    }
+    rows_made(&m);
+    const int lights = cut_regions(e, &m, max, out);
+    free(m.dw);
     return lights;
 }
 
@@ -297,7 +316,7 @@ void veil_env_part_integral(const veil_environment* e, int bright, double out[3]
 {
     out[0] = out[1] = out[2] = 0.0;
     if (!e || !e->present || !e->rgb) return;
-    env_map m = {e->width, e->height, e->rgb, {0, 0, 0}, bright ? PART_BRIGHT : PART_REST, e->clip};
+    env_map m = {e->width, e->height, e->rgb, {0, 0, 0}, bright ? PART_BRIGHT : PART_REST, e->clip, NULL};
     for (int j = 0; j < m.h; ++j) {
         double dw = veil_env_texel_solid_angle(m.w, m.h, j);
         for (int i = 0; i < m.w; ++i) {
@@ -327,7 +346,7 @@ veil_result veil_env_rest_table(const veil_environment* e, size_t max_texels, ve
     const int tw = (w + f - 1) / f, th = (h + f - 1) / f;
     float* en = malloc((size_t)tw * th * 8 * sizeof *en);
     if (!en) return veil_fail(err, VEIL_ERR_OOM, "out of memory for the environment's photon table (%dx%d)", tw, th);
-    env_map m = {w, h, e->rgb, {0, 0, 0}, PART_REST, e->clip};
+    env_map m = {w, h, e->rgb, {0, 0, 0}, PART_REST, e->clip, NULL};
     double total = 0.0, bound = 0.0;
     int n = 0;
     for (int bj = 0; bj < th; ++bj)
@@ -428,7 +447,7 @@ veil_result veil_env_dist_make(veil_environment* e, veil_error* err)
         free(d);
         return veil_fail(err, VEIL_ERR_OOM, "out of memory for the environment's sampling tables (%dx%d)", w, h);
     }
-    env_map m = {w, h, e->rgb, {0, 0, 0}, PART_ALL, 0.0};
+    env_map m = {w, h, e->rgb, {0, 0, 0}, PART_ALL, 0.0, NULL};
     double total = 0.0;
     for (int j = 0; j < h; ++j)
         for (int i = 0; i < w; ++i) total += texel_energy(&m, i, j);
