@@ -6,10 +6,12 @@
  *    the medium, and what the reference path tracer's paths meet);
  *  - the map as a few directional lights (median cut: Debevec, "A Median Cut
  *    Algorithm for Light Probe Sampling", SIGGRAPH 2005 poster / 2006),
- *    which is how the GPU pipeline carries it: each region of the sphere
- *    becomes one directional light with the region's irradiance, so the
- *    light-space optical depth, the light cache and the march need nothing
- *    new;
+ *    which is how the GPU pipeline carries it (or, by default under the
+ *    light cache, its bright part): each region of the sphere becomes one
+ *    directional light with the region's irradiance, so the light-space
+ *    optical depth, the light cache and the march need nothing new;
+ *  - the split into that bright part and a smooth rest, and the rest as a
+ *    table of texels the light cache's photons start from;
  *  - a distribution of directions proportional to the map's luminance
  *    times solid angle, with its pdf, for the reference's importance
  *    sampling (multiple importance sampling with the phase function).
