@@ -443,9 +443,12 @@ static veil_result volumetric_build(veil_frame* f, veil_stage_report* rep, veil_
         say(rep->why, sizeof rep->why, "no grid was made for the field");
     } else if (d.kind == VEIL_FIELD_CACHE) {
         const veil_cache_report* c = &vr.cache;
-        say(rep->why, sizeof rep->why, "the light cache: %lld photons from %d source%s, %dx%dx%d cells of %.4g m, "
+        const int env = c->env_rest[0] > 0.0 || c->env_rest[1] > 0.0 || c->env_rest[2] > 0.0;
+        say(rep->why, sizeof rep->why, "the light cache: %lld photons from %d source%s%s, %dx%dx%d cells of %.4g m, "
             "noise %.2g %% a cell (fluence-weighted RMS), %.1f MiB while built, %.1f MiB kept%s",
-            c->photons, c->sources, c->sources == 1 ? "" : "s", c->dims[0], c->dims[1], c->dims[2], (double)c->cell,
+            c->photons, c->sources, c->sources == 1 ? "" : "s",
+            env ? (c->sources == 1 ? " (the environment's rest)" : " (the environment's rest one of them)") : "",
+            c->dims[0], c->dims[1], c->dims[2], (double)c->cell,
             100.0 * c->noise, c->bytes / 1048576.0,
             (double)c->dims[0] * c->dims[1] * c->dims[2] * 64.0 / 1048576.0, /* the texture: four rgba32f grids */
             c->cut || c->clamped ? "" : "");
@@ -459,8 +462,9 @@ static veil_result volumetric_build(veil_frame* f, veil_stage_report* rep, veil_
                 ab += l * c->energy[VEIL_CACHE_ENERGY_ABSORBED][k];
             }
             size_t len = strlen(rep->why);
-            snprintf(rep->why + len, sizeof rep->why - len, "; of the light that scattered, %.1f %% left the grid, "
-                     "%.1f %% was absorbed", 100.0 * out / e_in, 100.0 * ab / e_in);
+            snprintf(rep->why + len, sizeof rep->why - len, "; of the light that scattered%s, %.1f %% left the grid, "
+                     "%.1f %% was absorbed", env ? " or came into the grid as the environment's rest" : "", 100.0 * out / e_in,
+                     100.0 * ab / e_in);
         }
         if (c->asked > c->photons) {
             size_t len = strlen(rep->why);
@@ -501,8 +505,8 @@ static veil_stage_status render_decide(const veil_frame_plan* p, int kept, char*
     const veil_multiple* ms = &p->scene->multiple;
     char multiple[200] = "";
     if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_CACHE)
-        snprintf(multiple, sizeof multiple,
-                 ", orders >= 2 from the light cache (stage volumetric; where it is not made, the octaves)");
+        snprintf(multiple, sizeof multiple, ", orders >= 2 from the light cache%s (stage volumetric; where it is "
+                 "not made, the octaves)", p->env_split ? ", every order of the environment's rest" : "");
     else if (ms->volumetric && ms->volumetric_method == VEIL_VOLUMETRIC_DIFFUSION)
         snprintf(multiple, sizeof multiple, ", multiple scattering from the diffusion field (stage volumetric)");
     else if (ms->volumetric && ms->octaves > 1)
