@@ -22,13 +22,21 @@
 
 static double lum(const double c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
-/* A w x h map whose texel (i, j) holds (i, j, 1 + i + w j). */
-static veil_environment indexed(int w, int h)
+/* A w x h map of "lights": 1, its texels to be filled (malloc'd). */
+static veil_environment blank_map(int w, int h)
 {
     veil_environment e;
     memset(&e, 0, sizeof e);
     e.present = 1, e.width = w, e.height = h, e.lights = 1;
     e.rgb = malloc((size_t)w * h * 3 * sizeof *e.rgb);
+    if (!e.rgb) exit(2); /* (a test's few kB) */
+    return e;
+}
+
+/* A w x h map whose texel (i, j) holds (i, j, 1 + i + w j). */
+static veil_environment indexed(int w, int h)
+{
+    veil_environment e = blank_map(w, h);
     for (int j = 0; j < h; ++j)
         for (int i = 0; i < w; ++i) {
             float* t = e.rgb + 3 * ((size_t)j * w + i);
@@ -99,10 +107,7 @@ static void test_solid_angles(void)
 /* A map black but for a disc of `deg` around unit direction s (radiance sun) and, with sky > 0, a sky. */
 static veil_environment sun_map(int w, int h, const double s[3], double deg, float sun, float sky)
 {
-    veil_environment e;
-    memset(&e, 0, sizeof e);
-    e.present = 1, e.width = w, e.height = h, e.lights = 1;
-    e.rgb = malloc((size_t)w * h * 3 * sizeof *e.rgb);
+    veil_environment e = blank_map(w, h);
     for (int j = 0; j < h; ++j)
         for (int i = 0; i < w; ++i) {
             double t = PI * (j + 0.5) / h, p = 2 * PI * (i + 0.5) / w;
