@@ -138,23 +138,20 @@ int veil_cli_check_outputs(const char* const* inputs, int n_in, const char* cons
 
 veil_run_file* veil_cli_scene_inputs(const char* path, const veil_scene* s, int per_frame, int extra, int* n)
 {
-    enum { FIELD = 48, PATH = 4096 };
+    enum { PATH = 4096 };
     size_t k = veil_scene_files(s, NULL, 0);
     size_t entries = 1 + k + (size_t)extra;
-    /* the entries, then each file's field name and (frame 1's) path */
-    char* block = calloc(1, entries * sizeof(veil_run_file) + k * (sizeof(veil_scene_file) + FIELD + PATH));
+    /* the entries, then each file (its field name inside) and (frame 1's) path */
+    char* block = calloc(1, entries * sizeof(veil_run_file) + k * (sizeof(veil_scene_file) + PATH));
     if (!block) return NULL;
     veil_run_file* files = (veil_run_file*)block;
     veil_scene_file* sf = (veil_scene_file*)(block + entries * sizeof(veil_run_file));
-    char* names = (char*)(sf + k);
-    char* paths = names + k * FIELD;
+    char* paths = (char*)(sf + k);
     veil_scene_files(s, sf, k);
     int m = 0;
     files[m++] = (veil_run_file){.what = "the scene", .path = path};
     for (size_t i = 0; i < k; ++i) {
-        char* field = names + i * FIELD;
-        snprintf(field, FIELD, "medium.sources[%zu].file", sf[i].source);
-        veil_run_file f = {.what = field, .path = sf[i].path};
+        veil_run_file f = {.what = sf[i].field, .path = sf[i].path};
         veil_error err = {0};
         if (sf[i].sequence && per_frame) f.naming = VEIL_RUN_PATTERN, f.offset = sf[i].frame_offset;
         else if (sf[i].sequence && veil_scene_file_at(&sf[i], 1, paths + i * PATH, PATH, &err) == VEIL_OK)

@@ -34,7 +34,8 @@ veil_result veil_cli_check_output_folder(const char* path, veil_error* err);
 int veil_cli_check_run(const veil_run_file* files, int n, const veil_frame_range* range);
 
 /* The run's inputs: the scene file `path` ("the scene") and each file s
- * reads (veil_scene_files, "medium.sources[i].file"): a sequence's pattern
+ * reads (veil_scene_files: "medium.sources[i].file", the environment's
+ * "lights[i].file"): a sequence's pattern
  * followed over the run's frames (per_frame), or its file of frame 1 (the
  * commands that render that frame of it). In one block with room for
  * `extra` more entries after the *n made; free() it. NULL: out of memory. */

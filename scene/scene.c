@@ -283,7 +283,7 @@ size_t veil_scene_files(const veil_scene* s, veil_scene_file* out, size_t n)
     size_t k = 0;
     for (size_t i = 0; i < s->medium.source_count; ++i) {
         const veil_source* src = &s->medium.sources[i];
-        veil_scene_file f = {.source = i};
+        veil_scene_file f = {.path = NULL};
         if (src->type == VEIL_SOURCE_VDB && src->vdb.sequence)
             f.path = src->vdb.sequence, f.sequence = 1, f.frame_offset = src->vdb.frame_offset;
         else if (src->type == VEIL_SOURCE_VDB)
@@ -291,6 +291,13 @@ size_t veil_scene_files(const veil_scene* s, veil_scene_file* out, size_t n)
         else if (src->type == VEIL_SOURCE_RBF)
             f.path = src->particle_file;
         if (!f.path) continue;
+        snprintf(f.field, sizeof f.field, "medium.sources[%zu].file", i);
+        if (k < n) out[k] = f;
+        ++k;
+    }
+    if (s->environment.present && s->environment.file) { /* issue 41: the map is an input as any other */
+        veil_scene_file f = {.path = s->environment.file};
+        snprintf(f.field, sizeof f.field, "lights[%zu].file", s->environment.light_index);
         if (k < n) out[k] = f;
         ++k;
     }

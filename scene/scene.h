@@ -291,7 +291,8 @@ typedef struct veil_scene_grid {
 #define VEIL_DEEP_MAX_SAMPLES 64
 
 typedef struct veil_scene {
-    char* path;     /* the file as given (owned) */
+    char* path;     /* the file as given, or the name messages give a scene from memory (owned) */
+    int path_is_file; /* 1: path is the file the scene was read from (veil_scene_load) */
     char* base_dir; /* its folder, for relative paths (owned) */
     veil_camera camera;
     veil_medium medium;
@@ -339,15 +340,17 @@ veil_result veil_scene_set_frame(veil_scene* s, long frame, veil_error* err);
 int veil_scene_is_sequence(const veil_scene* s);
 
 /* A file a scene reads besides itself: a VDB source's file or a sequence's
- * frame pattern, or an RBF source's particle file (points into the scene). */
+ * frame pattern, an RBF source's particle file, or the environment light's
+ * map (points into the scene). */
 typedef struct veil_scene_file {
-    size_t source;     /* medium.sources[source].file */
+    char field[48];    /* how a message names it: "medium.sources[2].file", "lights[1].file" */
     const char* path;  /* the file; a sequence's pattern when `sequence` */
     int sequence;      /* 1: frame f reads the pattern's frame f + frame_offset */
     long frame_offset;
 } veil_scene_file;
-/* The files s reads, in the order of its sources, into out[0 .. n);
- * returns how many there are (n = 0 counts them). No file is opened. */
+/* The files s reads, in the order of its sources, then the environment's
+ * map, into out[0 .. n); returns how many there are (n = 0 counts them).
+ * No file is opened. */
 size_t veil_scene_files(const veil_scene* s, veil_scene_file* out, size_t n);
 /* The file f names for frame `frame` (a sequence's: the pattern's frame
  * frame + frame_offset; otherwise f->path). VEIL_ERR_LIMIT when it does

@@ -3,7 +3,8 @@
 # and the output folders): every file a command writes -- each frame of a
 # range under -o and --png, the contact sheet, the movie and their staging
 # names -- against every file it reads -- the scene, its VDB and particle
-# files, each frame of a sequence, through symbolic and hard links -- and
+# files and the environment's map (issue 41), each frame of a sequence,
+# through symbolic and hard links -- and
 # against each other. A clash is a usage error (exit 2) naming both files,
 # with nothing written; so are review outputs that could only fail after
 # every frame (a directory, a folder that is a file, over 100 000 frames);
@@ -114,6 +115,34 @@ check "a frame's staging name is an input" 2 "-o 'out.exr' is first written as '
                       [{\"type\": \"vdb\", \"file\": \"out.exr.veil-staged$$\"}]}}" >staged.json
              exec "$0" render staged.json -o out.exr --width 16 --height 12' "$veil"
 rm -f out.exr.veil-staged*
+
+# --- issue 41, item 1: the environment map is an input of every command (a 2:1 EXR made without a GPU)
+"$veil" reference s2.json -o sky.exr --width 8 --height 4 --spp 2 >/dev/null 2>&1 || fail "reference wrote no map"
+cp sky.exr m1.exr
+ln -s sky.exr sky_link.exr
+sky_sum=$(cksum <sky.exr)
+for map in sky m1; do
+    printf '{"camera": {"position": [0, 0, 3], "look_at": [0, 0, 0], "width": 16, "height": 12},
+ "medium": {"sigma_s": [1, 1, 1], "sources": [{"type": "exponential", "density": 0.3, "falloff": 1,
+   "direction": [0, 1, 0], "origin": [0, 0, 0], "bounds": [[-1, -1, -1], [1, 1, 1]]}]},
+ "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": [1, 1, 1]},
+   {"type": "environment", "file": "%s.exr"}]}\n' "$map" >"reads_$map.json"
+done
+text="is lights[1].file 'sky.exr', which this run reads: it would be overwritten"
+check "render -o MAP" 2 "-o 'sky.exr' $text" "$veil" render reads_sky.json -o sky.exr
+check "render --png MAP" 2 "--png 'sky.exr' $text" "$veil" render reads_sky.json -o x.exr --png sky.exr
+check "render --deep MAP" 2 "--deep 'sky.exr' $text" "$veil" render reads_sky.json -o x.exr --deep sky.exr
+check "render -o a link to MAP" 2 "-o 'sky_link.exr' is lights[1].file 'sky.exr' under another name (a link)" \
+    "$veil" render reads_sky.json -o sky_link.exr
+check "render --turntable 2: frame 1 is the map" 2 "-o 'sky_0001.exr' (frame 1) is lights[1].file" \
+    bash -c 'cp sky.exr sky_0001.exr && sed s/sky.exr/sky_0001.exr/ reads_sky.json >rt.json &&
+             exec "$0" render rt.json -o sky.exr --turntable 2' "$veil"
+check "turntable: frame 1 named like the map" 2 "-o 'm1.exr' (frame 1) is lights[1].file 'm1.exr'" \
+    "$veil" turntable reads_m1.json -o 'm#.exr' --range 1-2
+check "fog -o MAP" 2 "-o 'sky.exr' $text" "$veil" fog frame.exr --scene reads_sky.json -o sky.exr
+check "reference -o MAP" 2 "-o 'sky.exr' $text" "$veil" reference reads_sky.json -o sky.exr --spp 2
+[ "$(cksum <sky.exr)" = "$sky_sum" ] && cmp -s sky.exr m1.exr || fail "an environment map was changed"
+touch -h -d '2000-01-01' sky.exr m1.exr sky_0001.exr sky_link.exr # inputs, older than the stamp: not written
 
 # --- item 2, and two frames of one pattern on one file
 check "-o 'f#.exr' --png 'f##.exr' --range 9-10" 2 "-o 'f10.exr' (frame 10) and --png 'f10.exr' (frame 10) are one file" \
