@@ -2,12 +2,14 @@
  * reader and the image writers. Every pointer argument is checked here, so
  * that a caller's NULL is a VEIL_ERR_INVALID naming the argument, never a
  * crash; the internal functions below assume valid arguments. */
+#define _POSIX_C_SOURCE 200809L /* stat's dev_t and ino_t */
 #include "../include/veil.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "../core/progress.h"
 #include "../core/result.h"
@@ -24,11 +26,28 @@
 struct veil_context {
     veil_gl* gl;
     veil_renderer* renderer;
+    /* Re-entry from the render's own progress callback (issue 41): a
+     * veil_render of this context while it renders is refused, and a
+     * veil_context_destroy is deferred to the end of the render, which it
+     * cancels. */
+    int rendering;
+    int destroy_pending;
 };
+
+/* A file the render read (the scene's file, its VDB, particle and
+ * environment files): an image is never written over one (issue 41). */
+typedef struct api_input {
+    char field[48]; /* "the scene", "lights[0].file", ... */
+    char* path;     /* owned, for messages */
+    dev_t dev;
+    ino_t ino;
+} api_input;
 
 struct veil_image {
     veil_image_set set;
     veil_render_stats stats;
+    api_input* inputs; /* owned */
+    size_t input_count;
 };
 
 #define VEIL__NULL_ARG(fn, arg) veil_fail(err, VEIL_ERR_INVALID, "%s: %s is NULL", fn, arg)
@@ -126,6 +145,10 @@ veil_result veil_context_create(const veil_context_desc* desc, veil_context** ou
 void veil_context_destroy(veil_context* ctx)
 {
     if (!ctx) return;
+    if (ctx->rendering) { /* from its render's progress callback: released when veil_render returns */
+        ctx->destroy_pending = 1;
+        return;
+    }
     /* its GL objects go while its context is current (another veil_context may have been since); a context
      * current on another thread cannot be made current here: its objects go with it, unfreed (misuse) */
     if (!ctx->gl || veil_gl_make_current(ctx->gl, NULL) == VEIL_OK) veil_renderer_destroy(ctx->renderer);
@@ -199,6 +222,49 @@ void veil_scene_close(veil_scene* scene)
 
 /* ---- render -------------------------------------------------------------- */
 
+/* Notes the files scene reads, as they are now (device and inode), in
+ * img: a file that does not exist (a scene from memory's name) is none. */
+static veil_result note_inputs(veil_image* img, const veil_scene* scene, veil_error* err)
+{
+    size_t k = veil_scene_files(scene, NULL, 0);
+    veil_scene_file* sf = calloc(k + 1, sizeof *sf);
+    img->inputs = calloc(k + 1, sizeof *img->inputs);
+    if (!sf || !img->inputs) {
+        free(sf);
+        return veil_fail(err, VEIL_ERR_OOM, "veil_render: out of memory");
+    }
+    veil_scene_files(scene, sf, k);
+    if (scene->path_is_file) sf[k++] = (veil_scene_file){.field = "the scene", .path = scene->path};
+    veil_result r = VEIL_OK;
+    for (size_t i = 0; i < k && r == VEIL_OK; ++i) {
+        char path[4096];
+        struct stat st;
+        veil_error inner = {{0}};
+        /* a sequence: veil_render reads frame 1's file (veil_scene_set_frame is the CLI's) */
+        if (veil_scene_file_at(&sf[i], 1, path, sizeof path, &inner) != VEIL_OK || stat(path, &st) != 0) continue;
+        api_input* in = &img->inputs[img->input_count];
+        memcpy(in->field, sf[i].field, sizeof in->field);
+        in->dev = st.st_dev, in->ino = st.st_ino;
+        if (!(in->path = malloc(strlen(path) + 1))) r = veil_fail(err, VEIL_ERR_OOM, "veil_render: out of memory");
+        else strcpy(in->path, path), img->input_count++;
+    }
+    free(sf);
+    return r;
+}
+
+/* VEIL_ERR_INVALID when path is (or links to) a file the render read. */
+static veil_result check_not_input(const veil_image* img, const char* fn, const char* path, veil_error* err)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) return VEIL_OK; /* not there: nothing of the render's can be lost */
+    for (size_t i = 0; i < img->input_count; ++i)
+        if (img->inputs[i].dev == st.st_dev && img->inputs[i].ino == st.st_ino)
+            return veil_fail(err, VEIL_ERR_INVALID, "%s: '%.900s' is %s '%.900s', which the render read: it would "
+                             "be overwritten", fn, path, img->inputs[i].field, img->inputs[i].path);
+    return VEIL_OK;
+}
+
+
 static veil_result check_render_desc(const veil_render_desc* d, veil_error* err)
 {
     if (d->width < 0 || d->height < 0 || d->width > VEIL_SCENE_MAX_IMAGE || d->height > VEIL_SCENE_MAX_IMAGE)
@@ -224,11 +290,19 @@ typedef struct api_progress {
     veil_progress_callback fn;
     void* user;
     const char* stage; /* the stage last reported */
+    veil_context* ctx; /* the rendering context, made current again after each call */
 } api_progress;
 
 static void api_progress_tell(api_progress* p, const char* stage, double done)
 {
-    if (p->fn(p->user, stage, done)) veil_progress_cancel();
+    /* the callback may render with another context on this thread, make one or destroy one: the thread's
+     * progress state and current GL context are this render's again when it returns (issue 41) */
+    veil_progress_state saved = veil_progress_save(), none = {0};
+    veil_progress_restore(&none); /* a render inside the callback reports to its own sink, or to none */
+    int stop = p->fn(p->user, stage, done);
+    veil_progress_restore(&saved);
+    if (veil_gl_make_current(p->ctx->gl, NULL) != VEIL_OK) stop = 1; /* the next GL call would fail: stop */
+    if (stop || p->ctx->destroy_pending) veil_progress_cancel();
 }
 
 static void api_progress_sink(void* user, const char* what, double done, double total)
@@ -250,6 +324,10 @@ veil_result veil_render(veil_context* ctx, const veil_scene* scene, const veil_r
     *out = NULL;
     if (!ctx) return VEIL__NULL_ARG("veil_render", "ctx");
     if (!scene) return VEIL__NULL_ARG("veil_render", "scene");
+    if (ctx->rendering)
+        return veil_fail(err, VEIL_ERR_INVALID, "veil_render: the context is rendering already (this call came from "
+                         "its render's progress callback): render with another veil_context, or after veil_render "
+                         "returns");
     veil_render_desc d;
     veil_result r = veil__desc_read(&render_desc_layouts, desc, &d, err);
     if (r == VEIL_OK) r = check_render_desc(&d, err);
@@ -262,9 +340,10 @@ veil_result veil_render(veil_context* ctx, const veil_scene* scene, const veil_r
     veil_camera cam = veil_camera_of_frame(&scene->camera, d.frame, d.frames);
     veil_render_opts opts = {.width = d.width, .height = d.height, .step_voxels = d.step_voxels,
                              .seed = d.seed, .camera = &cam};
-    api_progress prog = {d.progress, d.progress_user, NULL};
+    api_progress prog = {d.progress, d.progress_user, NULL, ctx};
     void* old_user = NULL;
     veil_progress_fn old = d.progress ? veil_progress_sink(api_progress_sink, &prog, &old_user) : NULL;
+    ctx->rendering = 1;
     r = veil_render_scene_images(ctx->renderer, scene, &opts, &img->set, &img->stats, err);
     if (d.progress) {
         if (r == VEIL_OK && prog.stage) api_progress_tell(&prog, prog.stage, 1.0);
@@ -272,6 +351,14 @@ veil_result veil_render(veil_context* ctx, const veil_scene* scene, const veil_r
             r = veil_fail(err, VEIL_ERR_CANCELLED, "cancelled by the progress callback as the render ended");
         veil_progress_sink(old, old_user, NULL);
     }
+    ctx->rendering = 0;
+    if (ctx->destroy_pending) { /* destroyed by its progress callback: the render stopped, and the context goes */
+        r = veil_fail(err, VEIL_ERR_INVALID, "veil_render: the progress callback destroyed the rendering context: the "
+                      "render was cancelled and the context is released now (destroy a context after its "
+                      "veil_render returns)");
+        veil_context_destroy(ctx);
+    }
+    if (r == VEIL_OK) r = note_inputs(img, scene, err);
     if (r != VEIL_OK) {
         veil_image_destroy(img);
         return r;
@@ -318,6 +405,8 @@ veil_result veil_image_write_exr(const veil_image* img, const char* path, int ao
 {
     if (!img) return VEIL__NULL_ARG("veil_image_write_exr", "img");
     if (!path) return VEIL__NULL_ARG("veil_image_write_exr", "path");
+    veil_result r = check_not_input(img, "veil_image_write_exr", path, err);
+    if (r != VEIL_OK) return r;
     return veil_image_set_write_exr(&img->set, path, aovs, err);
 }
 
@@ -327,6 +416,8 @@ veil_result veil_image_write_png(const veil_image* img, const char* path, float 
     if (!path) return VEIL__NULL_ARG("veil_image_write_png", "path");
     if (!isfinite(exposure))
         return veil_fail(err, VEIL_ERR_INVALID, "veil_image_write_png: exposure %g is not finite", (double)exposure);
+    veil_result r = check_not_input(img, "veil_image_write_png", path, err);
+    if (r != VEIL_OK) return r;
     return veil_write_png(path, img->set.width, img->set.height, img->set.rgba, exposure, err);
 }
 
@@ -351,5 +442,7 @@ void veil_image_destroy(veil_image* img)
 {
     if (!img) return;
     veil_image_set_free(&img->set);
+    for (size_t i = 0; i < img->input_count; ++i) free(img->inputs[i].path);
+    free(img->inputs);
     free(img);
 }

@@ -212,7 +212,10 @@ VEIL_API const float* veil_image_rgba(const veil_image* img);
 VEIL_API veil_result veil_image_channel(const veil_image* img, const char* name, float* out, veil_error* err);
 
 /* EXR, 32-bit float, ZIP: R, G, B, A, plus every other channel above when
- * aovs is non-zero. All or nothing: a failed write leaves no file. */
+ * aovs is non-zero. All or nothing: a failed write leaves no file. Neither
+ * writer writes over a file the render read (the scene's file, a VDB,
+ * particle or environment map file, also through a link): VEIL_ERR_INVALID
+ * naming both, and the file is left as it was. */
 VEIL_API veil_result veil_image_write_exr(const veil_image* img, const char* path, int aovs, veil_error* err);
 
 /* 8-bit sRGB PNG preview of the radiance times 2^exposure, tone-mapped. */

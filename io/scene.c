@@ -463,5 +463,6 @@ veil_result veil_scene_load(const char* path, veil_scene* out, veil_error* err)
     if (r != VEIL_OK) return r;
     r = veil_scene_parse(path, buf, len, out, err);
     free(buf);
+    if (r == VEIL_OK) out->path_is_file = 1;
     return r;
 }

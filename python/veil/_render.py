@@ -81,6 +81,7 @@ class Context:
     def __init__(self, force_software=False, debug=False):
         lib = _Lib.lib
         self._handle = None
+        self._rendering = False  # inside veil_render: close() is refused (a progress callback's)
         self._thread = threading.get_ident()
         self._thread_name = threading.current_thread().name
         desc = veil_context_desc(ctypes.sizeof(veil_context_desc), 1 if force_software else 0, 1 if debug else 0)
@@ -110,6 +111,10 @@ class Context:
         if self._handle is None:
             return
         self._use()
+        if self._rendering:
+            raise VeilError(RESULT_CODES["VEIL_ERR_INVALID"],
+                            "veil.Context.close: the context is rendering (this call came from its render's progress "
+                            "callback): close it once render() has returned")
         handle, self._handle = self._handle, None
         self._destroy(handle)
 
@@ -165,6 +170,7 @@ class _Scene:
         self.handle = None
         st = _scene.prepare(scene, quality, base_dir)
         self.name = st.path or st.name
+        self.file = st.file  # the scene's file (libveil knows it only when it opened the file itself)
         prepared = [_grids.prepare(name, value) for name, value in (grids or {}).items()]
         if prepared and not _Lib.has_grids:
             raise VeilError(RESULT_CODES["VEIL_ERR_INVALID"],
@@ -282,6 +288,17 @@ def _write(img, path, aovs, exposure):
     _check(code, err)
 
 
+def _check_not_scene(output, scene_file):
+    """The scene's own file is never written over (libveil refuses its other inputs: veil.h)."""
+    try:
+        same = scene_file is not None and os.path.samefile(output, scene_file)
+    except OSError:  # one of them is not there: nothing to lose
+        same = False
+    if same:
+        raise VeilError(RESULT_CODES["VEIL_ERR_INVALID"], "output: '%s' is the scene '%s', which the render read: it "
+                        "would be overwritten" % (os.fsdecode(os.fspath(output)), os.fsdecode(os.fspath(scene_file))))
+
+
 def _check_output(output):
     if output is None:
         return
@@ -321,6 +338,7 @@ def _render_one(ctx, scn, width, height, seed, step_voxels, frame, frames, progr
     desc.frame, desc.frames = frame, frames
     img = ctypes.c_void_p()
     err = _err()
+    ctx._rendering = True
     try:
         if bridge is not None:
             with bridge.interrupts():
@@ -328,6 +346,7 @@ def _render_one(ctx, scn, width, height, seed, step_voxels, frame, frames, progr
         else:
             code = lib.veil_render(handle, scn.handle, ctypes.byref(desc), ctypes.byref(img), ctypes.byref(err))
     finally:
+        ctx._rendering = False
         if close_bar is not None:
             close_bar()
     try:
@@ -349,6 +368,7 @@ def _render_one(ctx, scn, width, height, seed, step_voxels, frame, frames, progr
         out = _image_arrays(img, aovs)
         out.frame = frame
         if output is not None:
+            _check_not_scene(output, scn.file)
             _write(img, output, aovs, exposure)
             out.path = os.fspath(output)
         return out

@@ -22,8 +22,9 @@ class SceneText:
     or JSON text with the folder its relative paths resolve against and the
     name its messages start with."""
 
-    def __init__(self, text=None, base_dir=None, name=None, path=None, data=None, unparsed=None):
+    def __init__(self, text=None, base_dir=None, name=None, path=None, data=None, unparsed=None, file=None):
         self.text = text
+        self.file = path if file is None else file  # the scene's file, when it came from one
         self.unparsed = unparsed  # why Python's json could not read text that an override needed
         self.base_dir = base_dir
         self.name = name
@@ -123,7 +124,9 @@ def prepare(scene, quality=None, base_dir=None):
         except (OSError, UnicodeDecodeError):
             return SceneText(path=path)  # veil's own message: cannot open, not UTF-8
         folder = base_dir if base_dir is not None else os.path.dirname(os.path.abspath(path))
-        return _text_scene(text, folder, path, quality)
+        st = _text_scene(text, folder, path, quality)
+        st.file = path
+        return st
 
     if not isinstance(scene, str):
         raise TypeError("scene: expected a dict, JSON text or a path to a .json file, got %s"

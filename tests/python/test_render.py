@@ -187,6 +187,34 @@ def test_failed_render_writes_nothing(gl, grids_api, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.exr"]
 
 
+def test_output_never_overwrites_an_input(gl, tmp_path):
+    """Issue 41, item 1: output= naming the environment's map, the scene file or a link to either is refused
+    by the library (VEIL_ERR_INVALID naming the scene's field) and the file is left as it was; the same
+    scene renders to another name."""
+    fog = {"type": "exponential", "density": 0.5, "falloff": 1.0, "origin": [0, 0, 0], "direction": [0, 1, 0],
+           "bounds": [[-1, -1, -1], [1, 1, 1]]}
+    veil.render(scene(fog), size=(8, 4), output=tmp_path / "sky.exr")  # a 2:1 map
+    sky = (tmp_path / "sky.exr").read_bytes()
+    s = scene(fog)
+    s["lights"].append({"type": "environment", "file": "sky.exr"})
+    (tmp_path / "scene.json").write_text(json.dumps(s))
+    os.symlink("sky.exr", tmp_path / "link.exr")
+    os.link(tmp_path / "scene.json", tmp_path / "scene.png")
+    for source, target, field in ((s, "sky.exr", "lights[1].file"), (s, "link.exr", "lights[1].file"),
+                                  (tmp_path / "scene.json", "sky.exr", "lights[1].file"),
+                                  (tmp_path / "scene.json", "scene.png", "the scene")):
+        with pytest.raises(veil.VeilError) as e:
+            veil.render(source, base_dir=tmp_path, output=tmp_path / target)
+        assert e.value.name == "VEIL_ERR_INVALID" and field in e.value.message and "overwritten" in e.value.message
+    frames = veil.turntable(s, 2, base_dir=tmp_path, output=tmp_path / "sky#.exr")
+    next(frames)  # frame 0 is sky0.exr, not the map
+    os.link(tmp_path / "sky.exr", tmp_path / "sky1.exr")
+    with pytest.raises(veil.VeilError, match="lights\\[1\\].file"):
+        next(frames)
+    assert (tmp_path / "sky.exr").read_bytes() == sky and "environment" in (tmp_path / "scene.json").read_text()
+    assert veil.render(s, base_dir=tmp_path, output=tmp_path / "other.exr").path == str(tmp_path / "other.exr")
+
+
 def test_turntable(gl, tmp_path):
     s = scene({"type": "rbf", "particles": [{"center": [0.6, 0, 0], "amplitude": 2.0, "sharpness": 3.0}]})
     frames = list(veil.turntable(s, 4, start=1, output=tmp_path / "tt.####.exr"))
