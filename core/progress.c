@@ -26,3 +26,13 @@ void veil_progress_set_stage(const char* stage) { t_stage = stage; }
 const char* veil_progress_stage(void) { return t_stage; }
 void veil_progress_cancel(void) { t_cancelled = 1; }
 int veil_progress_cancelled(void) { return t_cancelled; }
+
+veil_progress_state veil_progress_save(void)
+{
+    return (veil_progress_state){t_fn, t_user, t_stage, t_cancelled};
+}
+
+void veil_progress_restore(const veil_progress_state* s)
+{
+    t_fn = s->fn, t_user = s->user, t_stage = s->stage, t_cancelled = s->cancelled;
+}

@@ -30,4 +30,17 @@ const char* veil_progress_stage(void);
 void veil_progress_cancel(void);
 int veil_progress_cancelled(void);
 
+/* The calling thread's progress state (sink, stage, cancel flag), saved
+ * before a caller's callback runs and restored after it: a callback may
+ * render with another context on this thread (issue 41), which installs
+ * its own sink and stages. */
+typedef struct veil_progress_state {
+    veil_progress_fn fn;
+    void* user;
+    const char* stage;
+    int cancelled;
+} veil_progress_state;
+veil_progress_state veil_progress_save(void);
+void veil_progress_restore(const veil_progress_state* s);
+
 #endif

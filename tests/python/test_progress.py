@@ -108,3 +108,43 @@ def test_tqdm_or_text_progress(gl, progress_api, capsys):
         with pytest.raises(ImportError, match="tqdm"):
             veil.render(scene({"type": "array", "grid": "density"}), grids={"density": sphere(4)},
                         progress="tqdm")
+
+
+@pytest.mark.parametrize("stage", ["inject", "propagate", "volumetric", "render"])
+def test_callbacks_that_touch_contexts(gl, progress_api, stage):
+    """Issue 41, item 3: inside the progress callback, at each stage, a new veil.Context rendering and closed,
+    and a nested render with this context or the default one: the outer render's pixels are a plain render's
+    bit for bit, a nested render of the rendering context and its close() are refused with VeilError, and
+    the context renders on. Before: SIGSEGV (close), SIGABRT (a new context), a wrong image (nesting)."""
+    s = fresh_scene(404)
+    with veil.Context() as truth_ctx:
+        truth = truth_ctx.render(s, seed=3)["rgba"]
+
+    for act in ("new context", "close own", "nested own", "nested default"):
+        seen = {}
+
+        def progress(st, done):
+            if st != stage or st in seen:
+                return None
+            seen[st] = True
+            if act == "new context":
+                with veil.Context() as other:
+                    np.testing.assert_array_equal(other.render(s, seed=3)["rgba"], truth)
+            elif act == "close own":
+                ctx.close()
+            elif act == "nested own":
+                ctx.render(s, seed=3)
+            else:
+                veil.render(s, seed=3)  # the default context: not the rendering one, so it renders
+            return None
+
+        with veil.Context() as ctx:
+            if act in ("close own", "nested own"):
+                with pytest.raises(veil.VeilError) as e:
+                    ctx.render(s, seed=3, progress=progress)
+                assert e.value.name == "VEIL_ERR_INVALID" and "rendering" in e.value.message, e.value.message
+                assert not ctx.closed
+            else:
+                np.testing.assert_array_equal(ctx.render(s, seed=3, progress=progress)["rgba"], truth)
+            assert seen, "the callback never reached %s" % stage
+            np.testing.assert_array_equal(ctx.render(s, seed=3)["rgba"], truth)  # and it renders on
