@@ -163,7 +163,11 @@ typedef struct veil_image veil_image;
  * value cancels the render: veil_render then returns VEIL_ERR_CANCELLED as
  * soon as the work in flight ends (between stages, between bands of rows
  * of the march) and makes no image. The stages a cancelled render did finish
- * stay cached in the context. */
+ * stay cached in the context. The callback may create, use and destroy
+ * other contexts (veil_render makes its own current again when the
+ * callback returns); veil_render of the rendering context from its callback
+ * is refused (VEIL_ERR_INVALID), and veil_context_destroy of it cancels the
+ * render, which returns VEIL_ERR_INVALID and releases the context. */
 typedef int (*veil_progress_callback)(void* user, const char* stage, double done);
 
 /* Zero means default in every field but size. */
