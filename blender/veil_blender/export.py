@@ -111,6 +111,10 @@ def _colour(c, k):
 def export_light(ob, matrix, warnings):
     """One veil light for the Light object `ob` placed by `matrix`, or None (with a warning)."""
     ld = ob.data
+    bad = [name for name, v in (("power", ld.energy), ("color", sum(ld.color))) if not math.isfinite(v)]
+    if bad:  # Python's max(0, nan) is 0: a NaN power would export as a black light, silently
+        raise ExportError("light '%s': its %s is not a number (power %r W, color %r)"
+                          % (ob.name, " and ".join(bad), ld.energy, tuple(ld.color)))
     if ld.energy < 0.0:
         warnings.append("light '%s': negative power %g W read as 0" % (ob.name, ld.energy))
     energy = max(0.0, ld.energy)
@@ -286,6 +290,10 @@ def export_volume(ob, matrix, depsgraph, settings, warnings, sequences_as_patter
     vs = orig.veil
     if not vol.filepath:
         raise ExportError("%s: no file (veil renders Volume objects that read a .vdb file)" % where)
+    if orig.packed_file is not None or vol.packed_file is not None:
+        # Blender reads the grids from the .blend; the path may not exist, or hold other data (issue 41)
+        raise ExportError("%s: its VDB is packed into the .blend file; veil reads VDB files on disk: unpack it "
+                          "(File > External Data > Unpack Resources) and export again" % where)
     lib = orig.library
     if not vol.grids.is_loaded:
         vol.grids.load()
@@ -302,8 +310,6 @@ def export_volume(ob, matrix, depsgraph, settings, warnings, sequences_as_patter
         raise ExportError("%s: cannot read '%s': %s" % (where, abs_file, vol.grids.error_message or 'not loaded'))
     if len(ob.modifiers) > 0:
         warnings.append("%s: modifiers ignored (veil reads the file's grids as they are)" % where)
-    if vol.packed_file is not None:
-        raise ExportError("%s: packed VDB files are not supported: unpack it (File > External Data > Unpack)" % where)
     density = _pick_density(vol, vs.density_grid.strip(), where)
     src = {'type': 'vdb', 'file': abs_file, 'grid': density}
     if sequences_as_pattern and orig.is_sequence:
@@ -411,6 +417,9 @@ def export_scene(depsgraph, *, sequences_as_pattern=False, size=None, render_vis
             skipped.add(ob.type.lower())
     if skipped:
         warnings.append("not exported (veil renders Volume objects and lights): %s objects" % ', '.join(sorted(skipped)))
+    if not sources:
+        warnings.append("no Volume object with veil's Volume panel on is rendered: the image holds no medium, "
+                        "only what lies behind")
     env = export_world(scene, warnings)
     if env is not None:
         lights.append(env)

@@ -1,5 +1,6 @@
 """veil's panels (Render, World and Volume data properties), the File > Export > veil scene operator,
 and Blender's own panels (camera, lights, volume file, output) switched on for the engine."""
+import errno
 import os
 
 import bpy
@@ -164,6 +165,39 @@ exec "${{VEIL:-veil}}" turntable "$scene" -o "$out" --range "$range" --degrees 0
 """
 
 
+def write_all(files):
+    """Writes [(path, text, mode or None)] all or nothing: each to a temporary file beside its target, then
+    all renamed over their targets once every one is written (issue 41: a full disk, a read-only or missing
+    folder, a target that is a directory leave every existing file as it was). OSError names the file."""
+    staged = []
+    try:
+        for path, text, mode in files:
+            if os.path.isdir(path):
+                raise OSError(errno.EISDIR, "cannot write '%s': it is a folder" % path)
+            tmp = "%s.veil-tmp%d" % (path, os.getpid())
+            staged.append(tmp)
+            try:
+                with open(tmp, "w", encoding="utf-8") as f:
+                    f.write(text)
+                    f.flush()
+                    os.fsync(f.fileno())
+                if mode is not None:
+                    os.chmod(tmp, mode)
+            except OSError as e:
+                raise OSError(e.errno, "cannot write '%s': %s" % (path, e.strerror or e)) from None
+        for (path, _, _), tmp in zip(files, staged):
+            try:
+                os.replace(tmp, path)
+            except OSError as e:
+                raise OSError(e.errno, "cannot write '%s': %s" % (path, e.strerror or e)) from None
+    finally:
+        for tmp in staged:
+            try:
+                os.remove(tmp)
+            except OSError:
+                pass
+
+
 class VEIL_OT_export_scene(bpy.types.Operator, ExportHelper):
     """Export the scene as a veil scene file (JSON), for veil render, veil turntable and Slurm"""
     bl_idname = "veil.export_scene"
@@ -196,22 +230,23 @@ class VEIL_OT_export_scene(bpy.types.Operator, ExportHelper):
         if self.relative_paths:
             for src in data['medium']['sources']:
                 src['file'] = os.path.relpath(src['file'], folder)
-        text = export.to_json(data) + "\n"
-        with open(path, "w", encoding="utf-8") as f:
-            f.write(text)
         scene = context.scene
         name = os.path.splitext(os.path.basename(path))[0]
         rng = frame_range(scene)
+        files = [(path, export.to_json(data) + "\n", None)]
         msg = "veil: wrote %s (frames %s: veil turntable %s -o %s.####.exr --range %s --degrees 0)" % (
             path, rng, os.path.basename(path), name, rng)
         if self.write_script:
             script = os.path.join(folder, name + ".render.sh")
-            with open(script, "w", encoding="utf-8") as f:
-                f.write(SCRIPT.format(blend=bpy.data.filepath or "an unsaved file", range=rng,
-                                      scene=os.path.basename(path), name=os.path.basename(script),
-                                      out=name + ".####.exr"))
-            os.chmod(script, 0o755)
+            files.append((script, SCRIPT.format(blend=bpy.data.filepath or "an unsaved file", range=rng,
+                                                scene=os.path.basename(path), name=os.path.basename(script),
+                                                out=name + ".####.exr"), 0o755))
             msg += "; %s" % script
+        try:
+            write_all(files)
+        except OSError as e:
+            self.report({'ERROR'}, "veil: %s" % e)
+            return {'CANCELLED'}
         self.report({'INFO'}, msg)
         return {'FINISHED'}
 
