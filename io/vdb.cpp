@@ -19,6 +19,9 @@
 #include "vdb.h"
 #include "vdb_header.hpp"
 #include "../core/text.h"
+extern "C" {
+#include "../core/progress.h"
+}
 #pragma GCC visibility pop
 
 #include <openvdb/openvdb.h>
@@ -725,6 +728,115 @@ FloatGrid::Ptr grown_topology(const FloatGrid& g, int reach)
     return out;
 }
 
+// A number for a message: "1.2e+31" rather than std::to_string's 32 digits.
+std::string number_text(double v)
+{
+    char b[32];
+    std::snprintf(b, sizeof b, "%.3g", v);
+    return b;
+}
+
+// Floor of c / b for a power of two b (and negative c).
+openvdb::Coord block_of(const Coord& c, int b)
+{
+    auto f = [b](int v) { return v >= 0 ? v / b : -((-v + b - 1) / b); };
+    return Coord(f(c.x()), f(c.y()), f(c.z()));
+}
+
+// The grown region's voxels at most (veil_vdb_advect_work): each leaf's and active tile's box grown by
+// reach, rounded out to blocks of b voxels, their union counted on a mask; stops (at_least) once the
+// union passes `stop` voxels.
+void count_grown(const FloatGrid& g, int reach, double stop, double& voxels, int& at_least)
+{
+    int b = 8;
+    while (b < reach / 32) b *= 2;
+    const double block = (double)b * b * b;
+    openvdb::MaskGrid::Ptr mask = openvdb::MaskGrid::create();
+    size_t boxes = 0;
+    voxels = 0.0, at_least = 0;
+    auto add = [&](CoordBBox box) {
+        box.expand(reach);
+        mask->tree().sparseFill(CoordBBox(block_of(box.min(), b), block_of(box.max(), b)), true, true);
+        if (++boxes % 256 == 0 && (double)mask->tree().activeVoxelCount() * block > stop) at_least = 1;
+    };
+    for (auto leaf = g.tree().cbeginLeaf(); leaf && !at_least; ++leaf) {
+        CoordBBox box;
+        leaf->evalActiveBoundingBox(box, true);
+        if (!box.empty()) add(box);
+    }
+    FloatGrid::ValueOnCIter it = g.cbeginValueOn();
+    it.setMaxDepth(FloatGrid::ValueOnCIter::LEAF_DEPTH - 1);
+    for (; it && !at_least; ++it) {
+        CoordBBox box;
+        it.getBoundingBox(box);
+        add(box);
+    }
+    voxels = (double)mask->tree().activeVoxelCount() * block;
+    if (voxels > stop) at_least = 1;
+}
+
+// The checks of a description shared by veil_vdb_advect_work_of and veil_vdb_advect_mean (NULL: fine).
+const char* bad_advect_desc(const veil_vdb_advect_desc* d)
+{
+    if (!d->times) return "no times";
+    if (d->n < 1 || d->n > VEIL_VDB_ADVECT_MAX_TIMES || !(d->scale >= 0.0) || !std::isfinite(d->scale) ||
+        !(d->max_step_voxels > 0.0) || !std::isfinite(d->max_step_voxels))
+        return "bad description";
+    for (int k = 0; k < d->n; ++k)
+        if (!std::isfinite(d->times[k])) return "a time is not finite";
+    return nullptr;
+}
+
+// The paths every voxel walks (veil_vdb_advect_mean): the same for all of them, as they depend on the
+// times alone. Each side of t = 0 walked outwards (times >= 0 ascending, times < 0 descending), its span
+// to each time in equal steps of at most step_time.
+struct advect_plan {
+    double m[4][4];   // g's index-to-world (column vectors)
+    double edge;      // the smallest voxel edge: a column's length
+    double speed;     // voxels per unit of time, at most
+    int reach = 0;
+    double displacement = 0.0; // max|v| scale max|t_k| / edge
+    std::vector<double> pos, neg;
+    double step_time = 0.0;
+    double reads_per_voxel = 0.0; // velocity reads (one at x, one a step) and the n samples of g
+};
+
+advect_plan plan_paths(const veil_vdb& g, const veil_vdb_velocity& vel, const veil_vdb_advect_desc& d,
+                       const std::string& where)
+{
+    advect_plan p;
+    const openvdb::math::Transform& xf = g.grid->transform();
+    if (!xf.baseMap()->isLinear())
+        fail_with(VEIL_ERR_INVALID, where + " has a non-affine transform (" + xf.baseMap()->type() + ")");
+    to_column_matrix(xf, p.m);
+    p.edge = HUGE_VAL;
+    for (int c = 0; c < 3; ++c)
+        p.edge = std::min(p.edge, std::sqrt(p.m[0][c] * p.m[0][c] + p.m[1][c] * p.m[1][c] + p.m[2][c] * p.m[2][c]));
+    double tmax = 0.0;
+    for (int k = 0; k < d.n; ++k) tmax = std::max(tmax, std::fabs(d.times[k]));
+    p.speed = vel.max * d.scale / p.edge;
+    p.displacement = p.speed * tmax;
+    if (!(p.displacement > 0.0)) return p; // nothing moves
+    if (!(p.displacement <= ADVECT_MAX_REACH))
+        fail_with(VEIL_ERR_LIMIT, where + ": motion blur moves it up to " + number_text(p.displacement) +
+                                      " voxels (at most " + std::to_string((long)ADVECT_MAX_REACH) +
+                                      "): check the velocity's unit and scale");
+    p.reach = (int)std::ceil(p.displacement) + 1;
+    for (int k = 0; k < d.n; ++k) (d.times[k] >= 0.0 ? p.pos : p.neg).push_back(d.times[k]);
+    std::sort(p.pos.begin(), p.pos.end());
+    std::sort(p.neg.begin(), p.neg.end(), [](double a, double b) { return a > b; });
+    p.step_time = d.max_step_voxels / p.speed; // the longest step (speed > 0 here)
+    p.reads_per_voxel = 1.0 + d.n;
+    for (const std::vector<double>* side : {&p.pos, &p.neg}) {
+        double t = 0.0;
+        for (double tk : *side) {
+            if (tk != t) p.reads_per_voxel += std::max(1.0, std::ceil(std::fabs(tk - t) / p.step_time));
+            t = tk;
+        }
+    }
+    return p;
+}
+
 // g with its values below 0 read as 0 (a copy; g when it has none).
 FloatGrid::ConstPtr clamped(const veil_vdb& g)
 {
@@ -1156,75 +1268,79 @@ veil_result veil_vdb_velocity_place(veil_vdb_velocity* v, const double m[4][4], 
     });
 }
 
+veil_result veil_vdb_advect_work_of(const veil_vdb* g, const veil_vdb_velocity* vel, const veil_vdb_advect_desc* d,
+                                    veil_vdb_advect_work* out, veil_error* err)
+{
+    if (!g || !vel || !d || !out) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_advect_work_of: missing argument");
+    *out = veil_vdb_advect_work{};
+    if (const char* bad = bad_advect_desc(d))
+        return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_advect_work_of: %s", bad);
+    return guarded(err, g->path.c_str(), [&] {
+        const advect_plan p = plan_paths(*g, *vel, *d, g->path + ": grid " + quoted(g->name));
+        out->reach = p.reach;
+        out->max_displacement_voxels = p.displacement;
+        if (p.reach == 0 || g->active == 0) return; // nothing moves: no work
+        count_grown(*g->grid, p.reach, 2.0 * (double)VEIL_VDB_ADVECT_MAX_VOXELS, out->voxels, out->at_least);
+        out->reads_per_voxel = p.reads_per_voxel;
+        out->reads = out->voxels * p.reads_per_voxel;
+    });
+}
+
 veil_result veil_vdb_advect_mean(veil_vdb* g, const veil_vdb_velocity* vel, const veil_vdb_advect_desc* d,
                                  veil_vdb_advect_report* report, veil_error* err)
 {
-    if (!g || !vel || !d || !d->times) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_advect_mean: missing argument");
-    if (d->n < 1 || d->n > VEIL_VDB_ADVECT_MAX_TIMES || !(d->scale >= 0.0) || !std::isfinite(d->scale) ||
-        !(d->max_step_voxels > 0.0) || !std::isfinite(d->max_step_voxels))
-        return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_advect_mean: bad description (n %d, scale %g, step %g)", d->n,
+    if (!g || !vel || !d) return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_advect_mean: missing argument");
+    if (const char* bad = bad_advect_desc(d))
+        return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_advect_mean: %s (n %d, scale %g, step %g)", bad, d->n,
                          d->scale, d->max_step_voxels);
-    double tmax = 0.0;
-    for (int k = 0; k < d->n; ++k) {
-        if (!std::isfinite(d->times[k]))
-            return veil_fail(err, VEIL_ERR_INVALID, "veil_vdb_advect_mean: time %d is not finite", k);
-        tmax = std::max(tmax, std::fabs(d->times[k]));
-    }
     veil_vdb_advect_report rep{};
     rep.voxels_in = rep.voxels_out = g->active;
     veil_result r = guarded(err, g->path.c_str(), [&] {
         const std::string where = g->path + ": grid " + quoted(g->name);
+        const advect_plan p = plan_paths(*g, *vel, *d, where);
+        rep.max_displacement_voxels = p.displacement;
+        if (p.reach == 0 || g->active == 0) return; // nothing moves: g as it is
+        rep.reach = p.reach;
         const openvdb::math::Transform& xf = g->grid->transform();
-        if (!xf.baseMap()->isLinear())
-            fail_with(VEIL_ERR_INVALID, where + " has a non-affine transform (" + xf.baseMap()->type() + ")");
-        double m[4][4];
-        to_column_matrix(xf, m);
-        double edge = HUGE_VAL; // the smallest voxel edge: a column's length
-        for (int c = 0; c < 3; ++c) edge = std::min(edge, std::sqrt(m[0][c] * m[0][c] + m[1][c] * m[1][c] + m[2][c] * m[2][c]));
-        const double speed = vel->max * d->scale / edge; // voxels per unit of time, at most
-        rep.max_displacement_voxels = speed * tmax;
-        if (!(rep.max_displacement_voxels > 0.0) || g->active == 0) return; // nothing moves: g as it is
-        if (!(rep.max_displacement_voxels <= ADVECT_MAX_REACH))
-            fail_with(VEIL_ERR_LIMIT, where + ": motion blur moves it up to " +
-                                          std::to_string(rep.max_displacement_voxels) + " voxels (at most " +
-                                          std::to_string((long)ADVECT_MAX_REACH) + "): check the velocity's unit and scale");
-        rep.reach = (int)std::ceil(rep.max_displacement_voxels) + 1;
+        // counted on a coarse mask before the region is made: grown voxel by voxel, a region over the
+        // limit costs its border's leaves first (a reach of 4 000 voxels: 6 GB)
+        double estimate = 0.0;
+        int at_least = 0;
+        count_grown(*g->grid, p.reach, 2.0 * (double)VEIL_VDB_ADVECT_MAX_VOXELS, estimate, at_least);
+        if (estimate > (double)VEIL_VDB_ADVECT_MAX_VOXELS)
+            fail_with(VEIL_ERR_LIMIT, where + ": motion blur over its active region grown by " +
+                                          std::to_string(p.reach) + " voxels (the largest displacement) covers " +
+                                          (at_least ? "over " : "about ") + number_text(estimate) +
+                                          " voxels, over the limit of " + std::to_string(VEIL_VDB_ADVECT_MAX_VOXELS) +
+                                          ": shorten the shutter or lower the velocity's scale");
         FloatGrid::ConstPtr src = d->clamp_negative ? clamped(*g) : FloatGrid::ConstPtr(g->grid);
-        FloatGrid::Ptr out = grown_topology(*src, rep.reach);
+        FloatGrid::Ptr out = grown_topology(*src, p.reach);
         const openvdb::Index64 voxels = out->activeVoxelCount();
         if (voxels > VEIL_VDB_ADVECT_MAX_VOXELS)
             fail_with(VEIL_ERR_LIMIT, where + ": motion blur over its active region grown by " +
-                                          std::to_string(rep.reach) + " voxels (the largest displacement) covers " +
+                                          std::to_string(p.reach) + " voxels (the largest displacement) covers " +
                                           std::to_string(voxels) + " voxels, over the limit of " +
                                           std::to_string(VEIL_VDB_ADVECT_MAX_VOXELS) +
                                           ": shorten the shutter or lower the velocity's scale");
         out->tree().voxelizeActiveTiles();
+        rep.reads = (double)voxels * p.reads_per_voxel;
 
         // k: a raw vector v moves an index point by k v per unit of time: (M^-1 lin) scale, M g's 3x3
         openvdb::Mat3d mc, lc;
         for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) mc(i, j) = m[i][j], lc(i, j) = vel->lin[i][j];
+            for (int j = 0; j < 3; ++j) mc(i, j) = p.m[i][j], lc(i, j) = vel->lin[i][j];
         const openvdb::Mat3d kc = mc.inverse() * lc;
-        // each side of t = 0, walked outwards: times >= 0 ascending, times < 0 descending
-        std::vector<double> pos, neg;
-        for (int k = 0; k < d->n; ++k) (d->times[k] >= 0.0 ? pos : neg).push_back(d->times[k]);
-        std::sort(pos.begin(), pos.end());
-        std::sort(neg.begin(), neg.end(), [](double a, double b) { return a > b; });
-        const double step_time = d->max_step_voxels / speed; // the longest step (speed > 0 here)
         const bool same = vel->grid->transform() == xf;
         const double inv_n = 1.0 / d->n;
 
         openvdb::tree::LeafManager<FloatGrid::TreeType> leaves(out->tree());
-        leaves.foreach([&](FloatGrid::TreeType::LeafNodeType& leaf, size_t) {
-            FloatGrid::ConstAccessor sacc = src->getConstAccessor(); // one per task: accessors cache
-            velocity_at v_at{*vel, xf, same, {}, vel->grid->getConstAccessor()};
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j) v_at.k[i][j] = kc(i, j) * d->scale;
+        auto blur_leaf = [&](FloatGrid::TreeType::LeafNodeType& leaf, FloatGrid::ConstAccessor& sacc,
+                             velocity_at& v_at) {
             for (auto it = leaf.beginValueOn(); it; ++it) {
                 const Coord c = it.getCoord();
                 const openvdb::Vec3d x(c.x(), c.y(), c.z()), vx = v_at(x); // both sides start at x
                 double sum = 0.0;
-                for (const std::vector<double>* side : {&pos, &neg}) {
+                for (const std::vector<double>* side : {&p.pos, &p.neg}) {
                     // backwards along v for h > 0: the first step a midpoint (RK2) one, the next ones
                     // two-step Adams-Bashforth for steps h after h_prev (second order as well, one
                     // velocity read a step): y -= h ((1 + q/2) v(y) - (q/2) v(y_prev)), q = h / h_prev
@@ -1232,7 +1348,7 @@ veil_result veil_vdb_advect_mean(veil_vdb* g, const veil_vdb_velocity* vel, cons
                     double t = 0.0, h_prev = 0.0;
                     for (double tk : *side) {
                         const double span = tk - t;
-                        const double steps = std::max(1.0, std::ceil(std::fabs(span) / step_time));
+                        const double steps = std::max(1.0, std::ceil(std::fabs(span) / p.step_time));
                         const double h = span / steps;
                         for (double s = 0; s < steps && h != 0.0; ++s) {
                             if (h_prev == 0.0) {
@@ -1253,7 +1369,27 @@ veil_result veil_vdb_advect_mean(veil_vdb* g, const veil_vdb_velocity* vel, cons
                 it.setValue(mean);
                 if (mean == 0.0f) it.setValueOff();
             }
-        });
+        };
+        // in parts of about VEIL_VDB_ADVECT_PART_READS reads, each in parallel (TBB, one accessor per task:
+        // accessors cache), the progress reported and a cancel honoured between them
+        const size_t n_leaves = leaves.leafCount();
+        const double leaf_reads = (double)FloatGrid::TreeType::LeafNodeType::SIZE * p.reads_per_voxel;
+        const size_t part = (size_t)std::max(1.0, std::floor(VEIL_VDB_ADVECT_PART_READS / leaf_reads));
+        for (size_t first = 0; first < n_leaves; first += part) {
+            if (veil_progress_cancelled())
+                fail_with(VEIL_ERR_CANCELLED, where + ": motion blur cancelled");
+            veil_progress("motion blur", (double)first, (double)n_leaves);
+            const size_t last = std::min(n_leaves, first + part);
+            tbb::parallel_for(tbb::blocked_range<size_t>(first, last), [&](const tbb::blocked_range<size_t>& range) {
+                FloatGrid::ConstAccessor sacc = src->getConstAccessor();
+                velocity_at v_at{*vel, xf, same, {}, vel->grid->getConstAccessor()};
+                for (int i = 0; i < 3; ++i)
+                    for (int j = 0; j < 3; ++j) v_at.k[i][j] = kc(i, j) * d->scale;
+                for (size_t i = range.begin(); i != range.end(); ++i) blur_leaf(leaves.leaf(i), sacc, v_at);
+            });
+        }
+        if (veil_progress_cancelled()) fail_with(VEIL_ERR_CANCELLED, where + ": motion blur cancelled");
+        veil_progress("motion blur", (double)n_leaves, (double)n_leaves);
         openvdb::tools::pruneInactive(out->tree());
         out->setName(g->name);
         out->setGridClass(openvdb::GRID_FOG_VOLUME);

@@ -222,7 +222,31 @@ typedef struct veil_vdb_advect_report {
     uint64_t voxels_in;    /* active voxels before (tiles counted by their voxels) */
     uint64_t voxels_out;   /* active voxels after (non-zero values) */
     double max_displacement_voxels; /* max|v| scale max|t_k| / edge */
+    double reads;          /* the reads made: voxels of the grown region x reads a voxel (veil_vdb_advect_work) */
 } veil_vdb_advect_report;
+
+/* What veil_vdb_advect_mean(g, vel, d) would do, counted before any voxel
+ * is made (issue 41: motion blur's work is refused over a budget before it
+ * starts, volume/motion_blur.h). Every voxel of the grown region walks the
+ * same steps (they depend on the times alone), so the reads are exact but
+ * for the region's voxels, which are counted on a mask of blocks of b^3
+ * voxels (b a power of two, at least 8 and at least reach / 32): each
+ * leaf's and active tile's box grown by the reach, rounded out to blocks,
+ * their union counted. An upper bound of the region's voxels, over it by
+ * at most (1 + 2b / (box + 2 reach))^3 (1.2 for a large reach); beyond
+ * 2^20 blocks of the mask the count stops (`at_least`: the region holds at
+ * least `voxels`, over VEIL_VDB_ADVECT_MAX_VOXELS). Costs a walk over g's
+ * leaves and a mask of at most 2^20 blocks' nodes: milliseconds. */
+typedef struct veil_vdb_advect_work {
+    int reach;                      /* as the report's */
+    double max_displacement_voxels; /* as the report's */
+    double voxels;                  /* the grown region's voxels, at most (at least, when at_least) */
+    int at_least;
+    double reads_per_voxel;         /* the paths' velocity reads plus the n samples of g, for each voxel */
+    double reads;                   /* voxels x reads_per_voxel */
+} veil_vdb_advect_work;
+veil_result veil_vdb_advect_work_of(const veil_vdb* g, const veil_vdb_velocity* vel, const veil_vdb_advect_desc* d,
+                                    veil_vdb_advect_work* out, veil_error* err);
 
 /* Replaces g's values by their blurred mean (same transform, so the same
  * lattice: native, sparse and dense volumes take it as they take g); g must
@@ -230,7 +254,12 @@ typedef struct veil_vdb_advect_report {
  * veil_vdb_place). With max|v| scale max|t_k| = 0 g is left as it is, bit
  * for bit. Errors: VEIL_ERR_INVALID for a bad description; VEIL_ERR_LIMIT
  * when the dilated region would hold more than VEIL_VDB_ADVECT_MAX_VOXELS
- * (naming the file, the grid and the reach); VEIL_ERR_OOM. */
+ * (naming the file, the grid and the reach), counted before the region is
+ * made; VEIL_ERR_OOM. Long work reports its progress (core/progress.h,
+ * "motion blur": voxels done of all) between parts of about
+ * VEIL_VDB_ADVECT_PART_READS reads, and a cancel asked for there ends it
+ * with VEIL_ERR_CANCELLED (g left as it was). */
+#define VEIL_VDB_ADVECT_PART_READS ((double)(1 << 23))
 veil_result veil_vdb_advect_mean(veil_vdb* g, const veil_vdb_velocity* vel, const veil_vdb_advect_desc* d,
                                  veil_vdb_advect_report* report, veil_error* err);
 

@@ -46,12 +46,25 @@ veil_result veil_motion_blur_open(const veil_scene* s, const veil_source* src, s
     return VEIL_OK;
 }
 
-veil_result veil_motion_blur_apply(const veil_motion_blur* mb, veil_vdb* g, int clamp_negative,
+veil_result veil_motion_blur_apply(const veil_motion_blur* mb, veil_vdb* g, int clamp_negative, double* seconds,
                                    veil_vdb_advect_report* report, veil_error* err)
 {
     if (report) memset(report, 0, sizeof *report);
     if (!mb->velocity) return VEIL_OK;
     const veil_vdb_advect_desc d = {mb->times, mb->samples, mb->per_frame, VEIL_BLUR_STEP_VOXELS, clamp_negative};
+    veil_vdb_advect_work w;
+    veil_result r = veil_vdb_advect_work_of(g, mb->velocity, &d, &w, err);
+    if (r != VEIL_OK) return r;
+    const double cost = w.reads * VEIL_BLUR_READ_SECONDS, before = seconds ? *seconds : 0.0;
+    if (w.at_least || before + cost > VEIL_BLUR_MAX_SECONDS)
+        return veil_fail(err, VEIL_ERR_LIMIT, "%s: grid '%s': motion blur by '%s' would move it up to %.3g voxels: "
+                         "%s%.3g voxels around it, %.0f reads each (%d samples and the paths' steps): %.3g s of "
+                         "CPU time%s, over the budget of %.0f s a frame (volume/motion_blur.h): check the velocity's "
+                         "unit and scale (cm/s read as m/s is 100 times too fast), or shorten the shutter",
+                         veil_vdb_path(g), veil_vdb_grid_name(g), mb->velocity_name, w.max_displacement_voxels,
+                         w.at_least ? "over " : "", w.voxels, w.reads_per_voxel, mb->samples,
+                         cost, before > 0.0 ? ", with the frame's blurs before it more" : "", VEIL_BLUR_MAX_SECONDS);
+    if (seconds) *seconds = before + cost;
     return veil_vdb_advect_mean(g, mb->velocity, &d, report, err);
 }
 

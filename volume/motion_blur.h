@@ -55,6 +55,21 @@
  * once a voxel along the way). */
 #define VEIL_BLUR_STEP_VOXELS 1.0
 
+/* The budget (issue 41). A blur's work is known before it starts
+ * (io/vdb.h, veil_vdb_advect_work_of): the region's voxels, each walking
+ * the same paths, so many reads (trilinear samples of the velocity along
+ * them, and of the grid at each time) a voxel. It grows as D^4 (the region
+ * as D^3, its paths as D): a velocity in cm/s read as m/s (100 times too
+ * fast) turns a second into days. A read costs VEIL_BLUR_READ_SECONDS of
+ * CPU time (measured on this project's 2-core machines, with its path's
+ * arithmetic: docs/performance.md, "Motion blur's budget"); a frame's blurs
+ * (every source's density, emission and temperature) may take
+ * VEIL_BLUR_MAX_SECONDS of it, the sparse estimate's budget
+ * (volume/sparse.h): over it a blur is refused before it starts, naming
+ * the grid, the displacement, the voxels, the reads and the seconds. */
+#define VEIL_BLUR_READ_SECONDS 5.5e-8
+#define VEIL_BLUR_MAX_SECONDS 40.0
+
 /* N for a displacement of d voxels over the shutter (see above). */
 int veil_motion_blur_samples(double d);
 /* The n midpoint times of [open, close] into t (frames). */
@@ -79,8 +94,11 @@ veil_result veil_motion_blur_open(const veil_scene* s, const veil_source* src, s
                                   veil_motion_blur* mb, veil_error* err);
 /* Replaces g (the source's density, emission or temperature grid, not yet
  * shared) by its blur; clamp_negative as veil_vdb_advect_desc. A no-op when
- * mb->velocity is NULL. */
-veil_result veil_motion_blur_apply(const veil_motion_blur* mb, veil_vdb* g, int clamp_negative,
+ * mb->velocity is NULL. *seconds: the CPU time the frame's blurs before
+ * this one were estimated to take, raised by this one's; VEIL_ERR_LIMIT
+ * when the sum would pass VEIL_BLUR_MAX_SECONDS (nothing done). Progress
+ * and cancel: io/vdb.h. */
+veil_result veil_motion_blur_apply(const veil_motion_blur* mb, veil_vdb* g, int clamp_negative, double* seconds,
                                    veil_vdb_advect_report* report, veil_error* err);
 void veil_motion_blur_close(veil_motion_blur* mb); /* accepts a zeroed one */
 

@@ -83,7 +83,7 @@ static veil_result open_emission(const veil_scene* s, veil_scene_volume* v, cons
     memset(es, 0, sizeof *es);
     es->grid = e;
     /* blurred with the density's velocity and times (a temperature below 0 is kept, as it is read) */
-    r = veil_motion_blur_apply(mb, e, !temperature, NULL, &inner);
+    r = veil_motion_blur_apply(mb, e, !temperature, &v->blur_seconds, NULL, &inner);
     if (r != VEIL_OK)
         return veil_fail(err, r, "medium.sources[%zu].%s.grid: motion blur: %.1900s", i,
                          temperature ? "temperature" : "emission", inner.msg);
@@ -116,9 +116,10 @@ static veil_result open_emission(const veil_scene* s, veil_scene_volume* v, cons
 static void note_blur(veil_scene_volume* v, size_t i, const veil_motion_blur* mb, const veil_vdb_advect_report* rep)
 {
     char note[256]; /* (what fits in v->motion is kept) */
-    snprintf(note, sizeof note, "; source %zu blurred by '%.64s': %d samples, %.3g voxels over the shutter%s", i,
-             mb->velocity_name, mb->samples, mb->displacement,
-             mb->displacement > VEIL_BLUR_MAX_SAMPLES ? " (capped)" : rep->reach ? "" : " (no motion)");
+    snprintf(note, sizeof note, "; source %zu blurred by '%.64s': %d samples, %.3g voxels over the shutter%s, "
+             "%.3g reads (~%.2g s of CPU)", i, mb->velocity_name, mb->samples, mb->displacement,
+             mb->displacement > VEIL_BLUR_MAX_SAMPLES ? " (capped)" : rep->reach ? "" : " (no motion)", rep->reads,
+             rep->reads * VEIL_BLUR_READ_SECONDS);
     size_t len = strlen(v->motion), n = strlen(note);
     if (len + n < sizeof v->motion) memcpy(v->motion + len, note, n + 1);
 }
@@ -148,7 +149,7 @@ static veil_result open_vdb(const veil_scene* s, veil_scene_volume* v, const vei
     veil_vdb_advect_report blur = {0};
     r = veil_motion_blur_open(s, src, i, vdb, &mb, err);
     if (r != VEIL_OK) return r;
-    r = veil_motion_blur_apply(&mb, vdb, 1, &blur, &inner);
+    r = veil_motion_blur_apply(&mb, vdb, 1, &v->blur_seconds, &blur, &inner);
     if (r != VEIL_OK) {
         veil_motion_blur_close(&mb);
         return veil_fail(err, r, "medium.sources[%zu]: motion blur: %.1900s", i, inner.msg);

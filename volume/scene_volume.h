@@ -48,9 +48,10 @@ typedef struct veil_scene_volume {
     veil_grid grid;
     /* How the grid was chosen, for --stats: "native: ..." or "resampled: ...",
      * and the files' grids that were not read ("; read 'density', not: vel (vec3s)") */
-    char resolution[320];
+    char resolution[416];
     char velocity_read[VEIL_MAX_VDB_SOURCES][96]; /* each vdb's velocity grid when blurred ("": none) */
-    char motion[160]; /* the sources' motion blur, "; source 0 blurred by 'vel': 4 samples, ..." ("": none) */
+    double blur_seconds; /* the CPU time the blurs were estimated to take (volume/motion_blur.h's budget) */
+    char motion[256]; /* the sources' motion blur, "; source 0 blurred by 'vel': 4 samples, ..." ("": none) */
     /* Emission ("emission" and "temperature" of vdb sources); the grid
      * above covers their supports too. */
     veil_emission_source emission[2 * VEIL_MAX_VDB_SOURCES];

@@ -29,7 +29,15 @@
  *   halving the step must cut the largest error by about 4 (at least 3
  *   asserted), and the coarsest error must stand far above float rounding;
  * - the stage key follows the shutter, the velocity and the frame rate;
- * - bad input: each refused with its field and the file and grid. */
+ * - bad input: each refused with its field and the file and grid;
+ * - the budget and the cancel (issue 41, items 4 and 5): the work counted
+ *   before a blur (veil_vdb_advect_work_of) has the blur's own reads a
+ *   voxel and bounds its region from above within the block rounding;
+ *   displacements of 417 and 4 167 voxels (the issue's) refused with the
+ *   numbers before any region is made (resident memory grows by under
+ *   64 MiB: the old code grew 6 GB); the blur reports its progress in
+ *   parts of at most VEIL_VDB_ADVECT_PART_READS reads plus a leaf's, and a
+ *   cancel asked for at a report ends it there, the grid as it was. */
 #define _POSIX_C_SOURCE 200809L
 #include <float.h>
 #include <math.h>
@@ -38,7 +46,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <sys/resource.h>
+
 #include "support/check.h"
+#include "core/progress.h"
 #include "io/scene.h"
 #include "io/vdb.h"
 #include "volume/motion_blur.h"
@@ -104,7 +115,7 @@ static void test_constant(void)
 {
     veil_error err = {0};
     veil_grid gb, gs, g0;
-    char note[400];
+    char note[416];
     float* blurred = volume_of(", \"velocity\": {\"grid\": \"vel\", \"unit\": \"frame\"}", SHUTTER, "", &gb, note,
                                sizeof note, &err);
     CHECK(blurred, "%s", err.msg);
@@ -341,6 +352,141 @@ static void test_bad_input(void)
     veil_scene_volume_close(&v);
 }
 
+/* ---- the budget and the cancel (issue 41) ------------------------------------------------------------- */
+
+static double max_rss_mib(void)
+{
+    struct rusage u;
+    getrusage(RUSAGE_SELF, &u);
+    return (double)u.ru_maxrss / 1024.0;
+}
+
+/* The work counted before a blur against the blur's own report, for the puff under "vel" (scale s) over
+ * the four times of SHUTTER. */
+static void work_against_blur(const char* path, const char* velocity, double scale)
+{
+    veil_error err = {0};
+    veil_vdb_velocity* vel = NULL;
+    veil_vdb* g = NULL;
+    CHECK(veil_vdb_velocity_open(path, velocity, &vel, NULL, 0, &err) == VEIL_OK, "%s", err.msg);
+    CHECK(veil_vdb_open(path, "density", 0, &g, NULL, 0, &err) == VEIL_OK, "%s", err.msg);
+    const double t[4] = {0.125, 0.25, 0.375, 0.5};
+    const veil_vdb_advect_desc d = {t, 4, scale, 1.0, 1};
+    veil_vdb_advect_work w;
+    veil_vdb_advect_report rep;
+    if (g && vel && veil_vdb_advect_work_of(g, vel, &d, &w, &err) == VEIL_OK &&
+        veil_vdb_advect_mean(g, vel, &d, &rep, &err) == VEIL_OK) {
+        const double region = rep.reads / w.reads_per_voxel; /* the grown region's voxels, as made */
+        /* the mask rounds each grown box out to blocks of b voxels: at most 2b more a side */
+        const double b = w.reach / 32 > 8 ? pow(2.0, ceil(log2(w.reach / 32.0))) : 8.0, side = 19.0 + 2 * w.reach;
+        const double bound = pow((side + 2 * b) / side, 3.0);
+        printf("work: %s x %g: reach %d, %.0f reads a voxel, %.4g voxels counted, %.4g made (%.3f; bound %.3f)\n",
+               velocity, scale, w.reach, w.reads_per_voxel, w.voxels, region, w.voxels / region, bound);
+        CHECK(w.reach == rep.reach && !w.at_least, "%s x %g: reach %d, blur's %d", velocity, scale, w.reach, rep.reach);
+        CHECK(region == floor(region) && w.reads_per_voxel >= 4 + 1, "%s x %g: reads a voxel %g do not divide the "
+              "blur's %g", velocity, scale, w.reads_per_voxel, rep.reads);
+        CHECK(w.voxels >= region && w.voxels <= bound * region, "%s x %g: counted %.4g voxels, made %.4g (bound %.3f)",
+              velocity, scale, w.voxels, region, bound);
+    } else {
+        CHECK(0, "%s x %g: %s", velocity, scale, err.msg);
+    }
+    veil_vdb_close(g);
+    veil_vdb_velocity_close(vel);
+}
+
+typedef struct cancel_log {
+    int reports, after_cancel, cancel_at; /* cancel at this report (0: never) */
+    double last_done, last_total, bad_order;
+} cancel_log;
+
+static void on_blur_progress(void* user, const char* what, double done, double total)
+{
+    cancel_log* c = user;
+    if (strcmp(what, "motion blur") != 0) return;
+    if (c->cancel_at && c->reports >= c->cancel_at) ++c->after_cancel;
+    if (done < c->last_done || done > total) ++c->bad_order;
+    c->last_done = done, c->last_total = total;
+    if (++c->reports == c->cancel_at) veil_progress_cancel();
+}
+
+static void test_budget(void)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/blur.vdb", g_dir);
+    work_against_blur(path, "vel", 1.0);
+    work_against_blur(path, "vel", 6.0);   /* reach 25 */
+    work_against_blur(path, "swirl", 1.5); /* a rotation: the region is still every leaf's box grown */
+
+    /* refusals before any region is made: "vel" 1 m a frame over [-0.5, 0.5] frames moves the puff 8 s
+     * voxels; 417 and 4 167 voxels are the issue's (45 min of CPU, and 6 GB before any voxel, before) */
+    const double rss0 = max_rss_mib();
+    const double scales[2] = {417.0 / 8.0, 4167.0 / 8.0};
+    for (int i = 0; i < 2; ++i) {
+        char puff[160];
+        snprintf(puff, sizeof puff, ", \"velocity\": {\"grid\": \"vel\", \"unit\": \"frame\", \"scale\": %.17g}",
+                 scales[i]);
+        char json[8192];
+        scene_json(json, sizeof json, "blur.vdb", puff, ", \"shutter\": [-0.5, 0.5]", "");
+        veil_scene s;
+        veil_scene_volume v;
+        memset(&v, 0, sizeof v);
+        veil_error err = {0};
+        veil_result r = veil_scene_parse("budget.json", json, strlen(json), &s, &err);
+        if (r == VEIL_OK) r = veil_scene_volume_open(&s, &v, &err), veil_scene_free(&s);
+        veil_scene_volume_close(&v);
+        printf("refused: %s\n", err.msg);
+        int digits = 0, run = 0; /* a number printed whole (the old "78749999750277699697348859396096.000000") */
+        for (const char* c = err.msg; *c; ++c) run = (*c >= '0' && *c <= '9') ? run + 1 : 0, digits = run > digits ? run : digits;
+        CHECK(r == VEIL_ERR_LIMIT && strstr(err.msg, "medium.sources[0]: motion blur") &&
+                  strstr(err.msg, "grid 'density'") && strstr(err.msg, "s of CPU time, over the budget of 40 s") &&
+                  strstr(err.msg, "unit and scale") && digits < 8,
+              "displacement %.0f: %s: %s", 8 * scales[i], veil_result_name(r), err.msg);
+    }
+    CHECK(max_rss_mib() - rss0 < 64.0, "the refusals grew resident memory by %.0f MiB", max_rss_mib() - rss0);
+
+    /* progress in parts, and a cancel at a report: "vel" x 12 moves the puff 36 voxels from t = 0 (6e7
+     * reads: about 3 s of CPU) */
+    veil_error err = {0};
+    veil_vdb_velocity* vel = NULL;
+    veil_vdb* g = NULL;
+    CHECK(veil_vdb_velocity_open(path, "vel", &vel, NULL, 0, &err) == VEIL_OK, "%s", err.msg);
+    const double t[4] = {-0.375, -0.125, 0.125, 0.375};
+    const veil_vdb_advect_desc d = {t, 4, 12.0, 1.0, 1};
+    for (int cancel_at = 0; cancel_at <= 2 && vel; cancel_at += 2) {
+        CHECK(veil_vdb_open(path, "density", 0, &g, NULL, 0, &err) == VEIL_OK, "%s", err.msg);
+        if (!g) break;
+        int lo[3], hi[3];
+        size_t before = 0, after = 0;
+        veil_vdb_index_bbox(g, lo, hi, &before);
+        veil_vdb_advect_work w = {0};
+        veil_vdb_advect_report rep = {0};
+        CHECK(veil_vdb_advect_work_of(g, vel, &d, &w, &err) == VEIL_OK, "%s", err.msg);
+        cancel_log log = {.cancel_at = cancel_at};
+        void* old_user = NULL;
+        veil_progress_fn old = veil_progress_sink(on_blur_progress, &log, &old_user);
+        veil_result r = veil_vdb_advect_mean(g, vel, &d, &rep, &err);
+        veil_progress_sink(old, old_user, NULL);
+        /* a part is at most PART_READS reads, plus one leaf's (a part holds whole leaves) */
+        const double part = VEIL_VDB_ADVECT_PART_READS + 512.0 * w.reads_per_voxel;
+        if (!cancel_at) {
+            printf("progress: %d reports over %.3g reads (parts of at most %.3g)\n", log.reports, rep.reads, part);
+            CHECK(r == VEIL_OK && log.bad_order == 0 && log.last_done == log.last_total && log.last_total > 0,
+                  "progress: %s: %s, %g of %g", veil_result_name(r), err.msg, log.last_done, log.last_total);
+            CHECK(log.reports >= 3 && (log.reports - 1) * part >= rep.reads, "%d reports for %.3g reads", log.reports,
+                  rep.reads);
+        } else {
+            veil_vdb_index_bbox(g, lo, hi, &after);
+            CHECK(r == VEIL_ERR_CANCELLED && log.after_cancel == 0 && strstr(err.msg, "motion blur cancelled") &&
+                      after == before,
+                  "cancel at report %d: %s: %s, %d reports after it", cancel_at, veil_result_name(r), err.msg,
+                  log.after_cancel);
+        }
+        veil_vdb_close(g);
+        g = NULL;
+    }
+    veil_vdb_velocity_close(vel);
+}
+
 int main(int argc, char** argv)
 {
     if (argc != 2) {
@@ -353,5 +499,6 @@ int main(int argc, char** argv)
     test_rotation();
     test_key();
     test_bad_input();
+    test_budget();
     return check_finish();
 }
