@@ -310,7 +310,10 @@ static void api_progress_sink(void* user, const char* what, double done, double 
     (void)what;
     api_progress* p = user;
     const char* stage = veil_progress_stage();
-    if (!stage) return;
+    if (!stage) { /* after the stages (a deep image merged): the last stage, done, so that it can still cancel */
+        if (p->stage) api_progress_tell(p, p->stage, 1.0);
+        return;
+    }
     if (p->stage && p->stage != stage) api_progress_tell(p, p->stage, 1.0);
     p->stage = stage;
     double share = total > 0.0 ? done / total : 0.0;

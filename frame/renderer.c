@@ -98,6 +98,13 @@ static veil_result run_frame(veil_renderer* r, veil_frame* f, veil_render_stats*
     if (o->deep && (o->deep_samples < 1 || o->deep_samples > VEIL_DEEP_MAX_SAMPLES))
         return veil_fail(err, VEIL_ERR_INVALID, "deep samples: expected 1..%d samples a pixel, got %d",
                          VEIL_DEEP_MAX_SAMPLES, o->deep_samples);
+    if (o->deep && veil_deep_bytes(o->width, o->height, o->deep_samples) > VEIL_DEEP_MAX_BYTES)
+        return veil_fail(err, VEIL_ERR_LIMIT, "a deep image of %dx%d pixels at %d samples a pixel: up to %d raw "
+                         "samples a pixel before the merge, %.3g GB, over the limit of %.3g GB (render/deep.h); "
+                         "the file up to %.3g GB: lower the deep samples or the size", o->width, o->height,
+                         o->deep_samples, veil_deep_raw_samples(o->deep_samples),
+                         veil_deep_bytes(o->width, o->height, o->deep_samples) / 1e9, VEIL_DEEP_MAX_BYTES / 1e9,
+                         (double)o->width * o->height * o->deep_samples * VEIL_DEEP_CHANNELS * sizeof(float) / 1e9);
     if (o->deep && o->behind) /* its samples would need the frame behind placed in depth */
         return veil_fail(err, VEIL_ERR_INVALID, "a deep image of a frame rendered in front of another (veil fog) "
                          "is not supported");

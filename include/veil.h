@@ -162,7 +162,9 @@ typedef struct veil_image veil_image;
  * "spread") and the share of it done, 0..1. Return 0 to go on; any other
  * value cancels the render: veil_render then returns VEIL_ERR_CANCELLED as
  * soon as the work in flight ends (between stages, between bands of rows
- * of the march) and makes no image. The stages a cancelled render did finish
+ * of the march and parts of every long loop) and makes no image. Work
+ * after the last stage (a deep image's merge) reports as that stage, done
+ * 1, and can cancel too. The stages a cancelled render did finish
  * stay cached in the context. The callback may create, use and destroy
  * other contexts (veil_render makes its own current again when the
  * callback returns); veil_render of the rendering context from its callback

@@ -5,12 +5,19 @@
 #include <string.h>
 
 #include "../core/clock.h"
+#include "../core/progress.h"
 #include "../core/shared.glsl.h"
 
 _Static_assert(VEIL_DEEP_SAMPLE_FLOATS == VEIL_DEEP_CHANNELS, "the march's deep samples are io/exr_deep.h's");
 _Static_assert(VEIL_DEEP_MAX_RAW >= VEIL_DEEP_MAX_SAMPLES, "a cap's raw samples are at least the cap");
 
 enum { F = VEIL_DEEP_CHANNELS };
+
+double veil_deep_bytes(int width, int height, int cap)
+{
+    const double raw = veil_deep_raw_samples(cap) * (double)VEIL_DEEP_CHANNELS * sizeof(float);
+    return (double)width * (double)height * (raw + sizeof(uint32_t) + VEIL_DEEP_WRITER_BYTES);
+}
 
 int veil_deep_raw_samples(int cap)
 {
@@ -188,6 +195,17 @@ static void measure_pixel(const float* raw, uint32_t n, const float* mer, uint32
         }
 }
 
+/* What pixel i's samples must flatten to (the flat image less T x what lies behind) into target; 1 when
+ * its colour is not all 0 (light a pixel without samples gets as one transparent sample). */
+static int pixel_target(size_t i, const float* rgba, const float* aov_t, const float background[3],
+                        const float* behind, double target[4])
+{
+    const float* bg = behind ? behind + 3 * i : background;
+    for (int c = 0; c < 3; ++c) target[c] = (double)rgba[4 * i + c] - (double)aov_t[4 * i + c] * bg[c];
+    target[3] = rgba[4 * i + 3];
+    return !(target[0] == 0.0 && target[1] == 0.0 && target[2] == 0.0);
+}
+
 veil_result veil_deep_finish(veil_deep_image* d, const float* rgba, const float* aov_t, const float background[3],
                              const float* behind, int cap, veil_deep_report* rep, veil_error* err)
 {
@@ -213,23 +231,42 @@ veil_result veil_deep_finish(veil_deep_image* d, const float* rgba, const float*
     }
     if (rep->max_raw > VEIL_DEEP_MAX_RAW)
         return veil_fail(err, VEIL_ERR_INVALID, "a pixel has %d deep samples (at most %d)", rep->max_raw, VEIL_DEEP_MAX_RAW);
-    float* out = malloc((d->total + empty) * F * sizeof *out + 1);
-    if (!out) return veil_fail(err, VEIL_ERR_OOM, "out of memory for %zu deep samples", d->total + empty);
+    /* merged in place (issue 41: a second copy doubled the peak): the raw samples moved up by the pixels
+     * that gain a sample (none, but for spread light over an empty pixel), so that the merged ones written
+     * from the start never pass the raw ones still to be read: after k pixels, written <= sum(n) + gained
+     * <= read + gained (each pixel keeps at most its samples, or one) */
+    size_t gain = 0;
+    for (size_t i = 0; i < pixels && front < back; ++i) {
+        double target[4];
+        if (d->counts[i] == 0) gain += pixel_target(i, rgba, aov_t, background, behind, target);
+    }
+    if (gain) {
+        float* grown = realloc(d->samples, (d->total + gain) * F * sizeof *grown);
+        if (!grown) return veil_fail(err, VEIL_ERR_OOM, "out of memory for %zu deep samples", d->total + gain);
+        d->samples = grown;
+        memmove(d->samples + gain * F, d->samples, d->total * F * sizeof *d->samples);
+    }
     rep->raw = d->total;
     float raw[VEIL_DEEP_MAX_RAW * F], mer[VEIL_DEEP_MAX_RAW * F];
-    const float* src = d->samples;
-    float* dst = out;
-    size_t lit = 0; /* holdout points of pixels with light (the colour error's mean) */
+    const float* src = d->samples + gain * F;
+    float* dst = d->samples;
+    size_t lit = 0, read = 0; /* holdout points of pixels with light (the colour error's mean); raw samples read */
     for (size_t i = 0; i < pixels; ++i) {
+        if (read >= VEIL_DEEP_PART_SAMPLES) { /* progress, and a cancel honoured, between parts */
+            read = 0;
+            veil_progress("deep merge", (double)i, (double)pixels);
+            if (veil_progress_cancelled())
+                return veil_fail(err, VEIL_ERR_CANCELLED, "cancelled by the progress callback while the deep "
+                                 "samples were merged (pixel %zu of %zu)", i, pixels);
+        }
         uint32_t n = d->counts[i];
+        read += n + 1;
         memcpy(raw, src, (size_t)n * F * sizeof *raw);
         src += (size_t)n * F;
         double target[4];
-        const float* bg = behind ? behind + 3 * i : background;
-        for (int c = 0; c < 3; ++c) target[c] = (double)rgba[4 * i + c] - (double)aov_t[4 * i + c] * bg[c];
-        target[3] = rgba[4 * i + 3];
+        const int light = pixel_target(i, rgba, aov_t, background, behind, target);
         if (n == 0) {
-            if ((target[0] == 0.0 && target[1] == 0.0 && target[2] == 0.0) || !(front < back)) continue;
+            if (!light || !(front < back)) continue;
             const float one[F] = {0, 0, 0, 0, front, back};
             memcpy(raw, one, sizeof one);
             n = 1;
@@ -243,9 +280,9 @@ veil_result veil_deep_finish(veil_deep_image* d, const float* rgba, const float*
         dst += (size_t)m * F;
         d->counts[i] = m;
     }
-    free(d->samples);
-    d->samples = out;
-    d->total = (size_t)(dst - out) / F;
+    d->total = (size_t)(dst - d->samples) / F;
+    float* shrunk = realloc(d->samples, d->total * F * sizeof *shrunk + 1);
+    if (shrunk) d->samples = shrunk;
     rep->kept = d->total;
     if (rep->holdout_points) rep->holdout_alpha_mean /= (double)rep->holdout_points;
     if (lit) rep->holdout_color_mean /= (double)lit;

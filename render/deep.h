@@ -47,6 +47,26 @@
 #define VEIL_DEEP_MAX_RAW 64
 int veil_deep_raw_samples(int cap);
 
+/* Memory (issue 41). The raw samples are kept until the frame is done
+ * (the flat image's last additions are spread over them): up to R a pixel
+ * of 24 bytes, then merged in place, and the writer holds a pointer a
+ * channel a pixel (VEIL_DEEP_WRITER_BYTES). veil_deep_bytes is that peak
+ * when every pixel has R samples (a medium over the whole frame: 1024 x 768
+ * at 64 samples is 1.2 GB, 4096^2 at 64 is 26 GB); a frame over
+ * VEIL_DEEP_MAX_BYTES is refused before any GPU work, with the numbers,
+ * rather than found out of memory after the march. 8 GiB: 4K at the
+ * default 8 samples a pixel (R = 32: 6.9 GB) fits, the documented limits
+ * (16384^2 at 64) do not. The file holds at most the cap's samples a
+ * pixel, ZIP-compressed. */
+#define VEIL_DEEP_WRITER_BYTES (VEIL_DEEP_CHANNELS * 8 + 8)
+#define VEIL_DEEP_MAX_BYTES ((double)((size_t)8 << 30))
+double veil_deep_bytes(int width, int height, int cap);
+
+/* The merge reports its progress (core/progress.h, "deep merge") and
+ * honours a cancel (VEIL_ERR_CANCELLED) between parts of this many raw
+ * samples (about 30 ms at 64 samples a pixel on this project's machines). */
+#define VEIL_DEEP_PART_SAMPLES ((size_t)1 << 18)
+
 /* The march's deep buffers hold at most this many bytes (a band's rows are
  * cut to fit, at least VEIL_MARCH_GROUP of them): 64 MiB. */
 #define VEIL_DEEP_BAND_BYTES ((size_t)64 << 20)

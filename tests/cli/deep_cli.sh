@@ -112,6 +112,16 @@ check "--deep-samples without --deep" 2 "--deep-samples: needs --deep" \
 check "deep.samples 0" 1 "deep.samples: expected an integer in [1, 64], got 0" \
     "$veil" render "$work/bad.json" -o "$work/x.exr" --deep "$work/xd.exr"
 [ ! -e "$work/x.exr" ] && [ ! -e "$work/xd.exr" ] || { echo "FAIL: a refused run wrote a file"; fails=$((fails + 1)); }
+# the deep image's memory, estimated before any GPU work (issue 41, item 6: 4096^2 at 64 samples took
+# ~37 GB before it failed): refused with the numbers, under 200 MB resident (not under ASan, whose shadow
+# memory adds ~110 MB), nothing written
+check "a deep image over the memory budget" 1 \
+    "a deep image of 4096x4096 pixels at 64 samples a pixel: up to 64 raw samples a pixel before the merge, 26.8 GB, over the limit of 8.59 GB" \
+    /usr/bin/time -f "rss %M" "$veil" render "$scene" -o "$work/x.exr" --deep "$work/xd.exr" --width 4096 --height 4096 --deep-samples 64
+rss=$(sed -n 's/^rss //p' "$work/out")
+ldd "$veil" 2>/dev/null | grep -q libasan && rss=0
+[ -n "$rss" ] && [ "$rss" -lt 204800 ] || { echo "FAIL: the refusal took ${rss:-?} KiB"; fails=$((fails + 1)); }
+[ ! -e "$work/x.exr" ] && [ ! -e "$work/xd.exr" ] || { echo "FAIL: a refused run wrote a file"; fails=$((fails + 1)); }
 
 # an unwritable deep path: its folder is a file
 echo "not a folder" >"$work/plain"

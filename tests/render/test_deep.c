@@ -32,14 +32,21 @@
  *    to one sample, the holdout at the gap reads the merged sample's
  *    split, and the report gives that error exactly (the anti-vacuity case:
  *    a merge that loses depth shows); the spread light of a pixel without
- *    samples lands on a transparent sample over the frame's medium depth. */
+ *    samples lands on a transparent sample over the frame's medium depth.
+ * 3. The merge of 2^19 raw samples (issue 41, item 6): its progress in
+ *    parts of at most VEIL_DEEP_PART_SAMPLES raw samples (plus a pixel's),
+ *    a cancel asked for at its first report ending it there
+ *    (VEIL_ERR_CANCELLED, no report after), and the memory estimate's
+ *    arithmetic. */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "support/check.h"
 #include "frame/renderer.h"
+#include "core/progress.h"
 #include "render/deep.h"
 #include "scene/camera.h"
 
@@ -208,9 +215,77 @@ static void gap(void)
     veil_deep_image_free(&d);
 }
 
+typedef struct merge_log {
+    int reports, cancel_at, after;
+    double last;
+} merge_log;
+
+static void on_merge(void* user, const char* what, double done, double total)
+{
+    merge_log* m = user;
+    if (strcmp(what, "deep merge") != 0) return;
+    if (m->cancel_at && m->reports >= m->cancel_at) ++m->after;
+    m->last = done / total;
+    if (++m->reports == m->cancel_at) veil_progress_cancel();
+}
+
+/* 512 x 64 pixels of 16 thin samples each (2^19 raw samples), merged to 4 */
+static void merge_parts(void)
+{
+    enum { MW = 512, MH = 64, N = 16 };
+    const size_t pixels = (size_t)MW * MH;
+    float* rgba = calloc(pixels * 4, sizeof *rgba);
+    float* aov_t = calloc(pixels * 4, sizeof *aov_t);
+    const float bg[3] = {0, 0, 0};
+    for (int cancel_at = 0; cancel_at <= 1 && rgba && aov_t; ++cancel_at) {
+        veil_deep_image d = {.width = MW, .height = MH, .total = pixels * N};
+        d.counts = malloc(pixels * sizeof *d.counts);
+        d.samples = malloc(d.total * F * sizeof *d.samples);
+        if (!d.counts || !d.samples) {
+            CHECK(0, "out of memory");
+            veil_deep_image_free(&d);
+            break;
+        }
+        for (size_t i = 0; i < pixels; ++i) {
+            d.counts[i] = N;
+            for (int k = 0; k < N; ++k) {
+                float* x = d.samples + (i * N + (size_t)k) * F;
+                x[0] = x[1] = x[2] = 0.01f, x[VEIL_DEEP_A] = 0.05f, x[VEIL_DEEP_Z] = 1.0f + (float)k;
+                x[VEIL_DEEP_ZBACK] = 1.5f + (float)k;
+            }
+            double f[4];
+            veil_deep_flatten(d.samples + i * N * F, N, f);
+            for (int c = 0; c < 4; ++c) rgba[4 * i + (size_t)c] = (float)f[c];
+        }
+        merge_log log = {.cancel_at = cancel_at};
+        void* old_user = NULL;
+        veil_progress_fn old = veil_progress_sink(on_merge, &log, &old_user);
+        veil_error err = {0};
+        veil_result r = veil_deep_finish(&d, rgba, aov_t, bg, NULL, 4, NULL, &err);
+        veil_progress_sink(old, old_user, NULL);
+        /* a part ends at the first pixel that passes VEIL_DEEP_PART_SAMPLES (n + 1 counted a pixel) */
+        const double part = (double)VEIL_DEEP_PART_SAMPLES + N + 1, raw = (double)pixels * (N + 1);
+        if (!cancel_at)
+            CHECK(r == VEIL_OK && d.total == pixels * 4 && log.reports >= (int)(raw / part) &&
+                      log.reports <= (int)(raw / VEIL_DEEP_PART_SAMPLES),
+                  "merge: %s: %s, %zu kept, %d reports", veil_result_name(r), err.msg, d.total, log.reports);
+        else
+            CHECK(r == VEIL_ERR_CANCELLED && log.after == 0 && strstr(err.msg, "deep samples were merged"),
+                  "cancel: %s: %s, %d reports after", veil_result_name(r), err.msg, log.after);
+        veil_deep_image_free(&d);
+    }
+    free(rgba), free(aov_t);
+    /* the estimate: R = min(4 cap, 64) raw samples of 24 bytes, a count and the writer's 56 bytes a pixel */
+    CHECK(veil_deep_bytes(1024, 768, 64) == 1024.0 * 768 * (64 * 24 + 4 + 56) &&
+              veil_deep_bytes(3840, 2160, 8) == 3840.0 * 2160 * (32 * 24 + 4 + 56) &&
+              veil_deep_bytes(3840, 2160, 8) < VEIL_DEEP_MAX_BYTES && veil_deep_bytes(4096, 4096, 64) > VEIL_DEEP_MAX_BYTES,
+          "deep bytes: %g, %g", veil_deep_bytes(1024, 768, 64), veil_deep_bytes(3840, 2160, 8));
+}
+
 int main(void)
 {
     gap();
+    merge_parts();
     veil_gl* gl = check_gpu_or_skip();
     veil_error err = {0};
     veil_renderer* r = NULL;
