@@ -120,6 +120,19 @@ static const veil__desc_layouts grid_desc_layouts = {"veil_scene_set_grid", "vei
                                                      VEIL__COUNT(grid_desc_releases)};
 _Static_assert(sizeof(veil_grid_desc) == sizeof(GRID_DESC_NEWEST), "veil_grid_desc changed: freeze its new layout above");
 
+typedef struct scene_desc_0_4 {
+    size_t size;
+    const char *path, *json, *base_dir, *name;
+    veil_progress_callback progress;
+    void* progress_user;
+} scene_desc_0_4;
+#define SCENE_DESC_NEWEST scene_desc_0_4
+static const veil__desc_layout scene_desc_releases[] = {VEIL__DESC_LAYOUT(scene_desc_0_4, progress_user)};
+static const veil__desc_layouts scene_desc_layouts = {"veil_scene_create", "veil_scene_desc", scene_desc_releases,
+                                                      VEIL__COUNT(scene_desc_releases)};
+_Static_assert(sizeof(veil_scene_desc) == sizeof(SCENE_DESC_NEWEST),
+               "veil_scene_desc changed: freeze its new layout above");
+
 /* ---- context ------------------------------------------------------------- */
 
 veil_result veil_context_create(const veil_context_desc* desc, veil_context** out, veil_error* err)
@@ -158,14 +171,40 @@ void veil_context_destroy(veil_context* ctx)
 
 /* ---- scene --------------------------------------------------------------- */
 
-veil_result veil_scene_open(const char* path, veil_scene** out, veil_error* err)
+/* The caller's progress callback while a scene is read (veil_scene_create): every report is the stage
+ * "scene", its share done kept from going back (reading a map, then cutting it: each 0..1 of itself). */
+typedef struct scene_progress {
+    veil_progress_callback fn;
+    void* user;
+    double done;
+} scene_progress;
+
+static void scene_progress_sink(void* user, const char* what, double done, double total)
 {
-    if (!out) return VEIL__NULL_ARG("veil_scene_open", "out");
-    *out = NULL;
-    if (!path) return VEIL__NULL_ARG("veil_scene_open", "path");
+    scene_progress* p = user;
+    /* reading the files: the first quarter; cutting the environment map into lights: the rest */
+    const double share = total > 0.0 ? fmin(fmax(done / total, 0.0), 1.0) : 0.0;
+    const double at = strncmp(what, "cutting", 7) == 0 ? 0.25 + 0.75 * share : 0.25 * share;
+    p->done = fmax(p->done, at);
+    veil_progress_state saved = veil_progress_save(), none = {0};
+    veil_progress_restore(&none); /* the callback may read scenes or render: to sinks of their own */
+    const int stop = p->fn(p->user, "scene", p->done);
+    veil_progress_restore(&saved);
+    if (stop) veil_progress_cancel();
+}
+
+static veil_result scene_read(const char* fn, const char* path, const char* json, const char* base_dir,
+                              const char* name, veil_progress_callback progress, void* progress_user,
+                              veil_scene** out, veil_error* err)
+{
     veil_scene* s = calloc(1, sizeof *s);
-    if (!s) return veil_fail(err, VEIL_ERR_OOM, "veil_scene_open: out of memory");
-    veil_result r = veil_scene_load(path, s, err);
+    if (!s) return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory", fn);
+    scene_progress prog = {progress, progress_user, 0.0};
+    void* old_user = NULL;
+    veil_progress_fn old = progress ? veil_progress_sink(scene_progress_sink, &prog, &old_user) : NULL;
+    veil_result r = path ? veil_scene_load(path, s, err)
+                         : veil_scene_parse_in(name ? name : "<json>", json, json ? strlen(json) : 0, base_dir, s, err);
+    if (progress) veil_progress_sink(old, old_user, NULL);
     if (r != VEIL_OK) {
         veil_scene_close(s);
         return r;
@@ -174,21 +213,35 @@ veil_result veil_scene_open(const char* path, veil_scene** out, veil_error* err)
     return VEIL_OK;
 }
 
+veil_result veil_scene_open(const char* path, veil_scene** out, veil_error* err)
+{
+    if (!out) return VEIL__NULL_ARG("veil_scene_open", "out");
+    *out = NULL;
+    if (!path) return VEIL__NULL_ARG("veil_scene_open", "path");
+    return scene_read("veil_scene_open", path, NULL, NULL, NULL, NULL, NULL, out, err);
+}
+
 veil_result veil_scene_from_json(const char* json, const char* base_dir, const char* name, veil_scene** out,
                                  veil_error* err)
 {
     if (!out) return VEIL__NULL_ARG("veil_scene_from_json", "out");
     *out = NULL;
     if (!json) return VEIL__NULL_ARG("veil_scene_from_json", "json");
-    veil_scene* s = calloc(1, sizeof *s);
-    if (!s) return veil_fail(err, VEIL_ERR_OOM, "veil_scene_from_json: out of memory");
-    veil_result r = veil_scene_parse_in(name ? name : "<json>", json, strlen(json), base_dir, s, err);
-    if (r != VEIL_OK) {
-        veil_scene_close(s);
-        return r;
-    }
-    *out = s;
-    return VEIL_OK;
+    return scene_read("veil_scene_from_json", NULL, json, base_dir, name, NULL, NULL, out, err);
+}
+
+veil_result veil_scene_create(const veil_scene_desc* desc, veil_scene** out, veil_error* err)
+{
+    if (!out) return VEIL__NULL_ARG("veil_scene_create", "out");
+    *out = NULL;
+    if (!desc) return VEIL__NULL_ARG("veil_scene_create", "desc");
+    veil_scene_desc d;
+    veil_result r = veil__desc_read(&scene_desc_layouts, desc, &d, err);
+    if (r != VEIL_OK) return r;
+    if (!d.path == !d.json)
+        return veil_fail(err, VEIL_ERR_INVALID, "veil_scene_create: give exactly one of desc->path and desc->json "
+                         "(%s)", d.path ? "both given" : "neither given");
+    return scene_read("veil_scene_create", d.path, d.json, d.base_dir, d.name, d.progress, d.progress_user, out, err);
 }
 
 veil_result veil_scene_set_grid(veil_scene* scene, const char* name, const veil_grid_desc* grid, veil_error* err)

@@ -59,14 +59,14 @@
 /* This header's version (CMakeLists.txt reads the project's version from
  * these three lines). */
 #define VEIL_VERSION_MAJOR 0
-#define VEIL_VERSION_MINOR 3
+#define VEIL_VERSION_MINOR 4
 #define VEIL_VERSION_PATCH 0
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* The loaded library's version: "0.3.0". */
+/* The loaded library's version: "0.4.0". */
 VEIL_API const char* veil_version(void);
 
 /* The loaded library's version as numbers (each output may be NULL). */
@@ -113,6 +113,48 @@ VEIL_API veil_result veil_scene_from_json(const char* json, const char* base_dir
                                           veil_error* err);
 VEIL_API void veil_scene_close(veil_scene* scene); /* accepts NULL */
 
+/* Reading a scene with a progress callback (veil 0.4), so that a long
+ * read can be cancelled: an environment map of 2^25 texels takes seconds
+ * to decode and cut into lights. Zero means default in every field but
+ * size. progress (veil_progress_callback: see just below) is called with
+ * the stage "scene" and the share done as the files the scene names are
+ * read; a non-zero return cancels: VEIL_ERR_CANCELLED, no scene. */
+
+/* Progress (veil 0.3): called on the rendering thread as the work goes on,
+ * with the stage ("inject", "propagate", "volumetric", "render" or
+ * "spread") and the share of it done, 0..1. Return 0 to go on; any other
+ * value cancels the render: veil_render then returns VEIL_ERR_CANCELLED as
+ * soon as the work in flight ends (between stages, between bands of rows
+ * of the march and parts of every long loop) and makes no image. Work
+ * after the last stage (a deep image's merge) reports as that stage, done
+ * 1, and can cancel too. The stages a cancelled render did finish
+ * stay cached in the context. The callback may create, use and destroy
+ * other contexts (veil_render makes its own current again when the
+ * callback returns); veil_render of the rendering context from its callback
+ * is refused (VEIL_ERR_INVALID), and veil_context_destroy of it cancels the
+ * render, which returns VEIL_ERR_INVALID and releases the context. */
+typedef int (*veil_progress_callback)(void* user, const char* stage, double done);
+
+typedef struct veil_scene_desc {
+    size_t size;          /* sizeof(veil_scene_desc) (see the top) */
+    const char* path;     /* a scene file, as veil_scene_open; or NULL and json: */
+    const char* json;     /* JSON text, as veil_scene_from_json */
+    const char* base_dir; /* json: what relative paths resolve against (NULL or "": the current folder) */
+    const char* name;     /* json: what messages start with (NULL: "<json>") */
+    veil_progress_callback progress; /* NULL: none */
+    void* progress_user;             /* passed to progress */
+} veil_scene_desc;
+
+#ifdef __cplusplus
+#define VEIL_SCENE_DESC_INIT {sizeof(veil_scene_desc), nullptr, nullptr, nullptr, nullptr, nullptr, nullptr}
+#else
+#define VEIL_SCENE_DESC_INIT {.size = sizeof(veil_scene_desc)}
+#endif
+
+/* Reads the scene desc names (a file, or JSON text: exactly one of path
+ * and json) into *out; errors as veil_scene_open and veil_scene_from_json. */
+VEIL_API veil_result veil_scene_create(const veil_scene_desc* desc, veil_scene** out, veil_error* err);
+
 /* ---- grids from memory (veil 0.3) ---------------------------------------- */
 
 /* How a grid's values lie in memory. */
@@ -156,21 +198,6 @@ VEIL_API veil_result veil_scene_set_grid(veil_scene* scene, const char* name, co
 /* ---- render ------------------------------------------------------------ */
 
 typedef struct veil_image veil_image;
-
-/* Progress (veil 0.3): called on the rendering thread as the work goes on,
- * with the stage ("inject", "propagate", "volumetric", "render" or
- * "spread") and the share of it done, 0..1. Return 0 to go on; any other
- * value cancels the render: veil_render then returns VEIL_ERR_CANCELLED as
- * soon as the work in flight ends (between stages, between bands of rows
- * of the march and parts of every long loop) and makes no image. Work
- * after the last stage (a deep image's merge) reports as that stage, done
- * 1, and can cancel too. The stages a cancelled render did finish
- * stay cached in the context. The callback may create, use and destroy
- * other contexts (veil_render makes its own current again when the
- * callback returns); veil_render of the rendering context from its callback
- * is refused (VEIL_ERR_INVALID), and veil_context_destroy of it cancels the
- * render, which returns VEIL_ERR_INVALID and releases the context. */
-typedef int (*veil_progress_callback)(void* user, const char* stage, double done);
 
 /* Zero means default in every field but size. */
 typedef struct veil_render_desc {

@@ -16,6 +16,7 @@
 
 #include "image.h"
 #include "exr_io.h"
+#include "../core/progress.h"
 
 #include <openexr.h>
 
@@ -112,6 +113,8 @@ typedef struct read_request {
     int optional;             /* index of the one that may be absent (read as 1), or -1 */
     veil_result missing_code; /* when another one is absent */
     const char* missing_note; /* said after the missing names */
+    uint64_t max_pixels;      /* 0: VEIL_EXR_MAX_PIXELS */
+    const char* what;         /* the progress reports' phrase ("reading sky.exr"); NULL: none */
 } read_request;
 
 typedef struct read_target {
@@ -122,7 +125,18 @@ typedef struct read_target {
     int min_x, min_y; /* data window origin */
     uint64_t file_size;
     uint64_t* chunk_too_big; /* set to a chunk's unpacked bytes when over VEIL_EXR_MAX_CHUNK */
+    const char* what;        /* progress reports (core/progress.h) as the pixels are decoded; NULL: none */
 } read_target;
+
+/* Between chunks, once VEIL_EXR_PART_PIXELS more pixels are decoded: the progress (done of all the image's
+ * pixels) and the cancel flag; 1 when cancelled. */
+static int between_chunks(const read_target* t, uint64_t done, uint64_t* reported)
+{
+    if (!t->pixels || !t->what || done - *reported < VEIL_EXR_PART_PIXELS) return 0;
+    *reported = done;
+    veil_progress(t->what, (double)done, (double)t->width * (double)t->height);
+    return veil_progress_cancelled();
+}
 
 /* Decodes one chunk whose top-left pixel is (x0, y0) relative to the data
  * window into the target. *pipeline_ready tracks the shared pipeline. */
@@ -173,7 +187,8 @@ static veil_result read_pixels(exr_const_context_t ctx, const char* path, exr_st
                                exr_msgs* msgs, veil_error* err)
 {
     exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
-    int ready = 0;
+    int ready = 0, cancelled = 0;
+    uint64_t reported = 0;
     exr_result_t rv = EXR_ERR_SUCCESS;
     char where[96] = "";
 
@@ -194,6 +209,10 @@ static veil_result read_pixels(exr_const_context_t ctx, const char* path, exr_st
             rv = decode_chunk(ctx, &ci, 0, (int)(ci.start_y - t->min_y), t, &dec, &ready);
             if (rv != EXR_ERR_SUCCESS) break;
             y = (int64_t)ci.start_y + ci.height;
+            if (between_chunks(t, (uint64_t)(y - t->min_y) * (uint64_t)t->width, &reported)) {
+                cancelled = 1;
+                break;
+            }
         }
     } else {
         uint32_t tile_w = 0, tile_h = 0;
@@ -216,10 +235,17 @@ static veil_result read_pixels(exr_const_context_t ctx, const char* path, exr_st
                 rv = exr_read_tile_chunk_info(ctx, 0, (int)tx, (int)ty, 0, 0, &ci);
                 if (rv == EXR_ERR_SUCCESS)
                     rv = decode_chunk(ctx, &ci, (int)(tx * tile_w), (int)(ty * tile_h), t, &dec, &ready);
+                if (rv == EXR_ERR_SUCCESS && between_chunks(t, (uint64_t)(ty * nx + tx + 1) * tile_w * tile_h, &reported)) {
+                    cancelled = 1;
+                    break;
+                }
             }
+            if (cancelled) break;
         }
     }
     if (ready) exr_decoding_destroy(ctx, &dec);
+    if (cancelled)
+        return veil_fail(err, VEIL_ERR_CANCELLED, "%s: cancelled while its pixels were read (at %s)", path, where);
     if (rv != EXR_ERR_SUCCESS && *t->chunk_too_big)
         return veil_fail(err, VEIL_ERR_LIMIT, "%s: the OpenEXR chunk at %s unpacks to %" PRIu64 " bytes, more than the "
                          "%d MiB veil reads in a chunk", path, where, *t->chunk_too_big, (int)(VEIL_EXR_MAX_CHUNK >> 20));
@@ -273,6 +299,9 @@ static veil_result read_channels(exr_const_context_t ctx, const char* path, uint
     if ((uint64_t)w * (uint64_t)h > VEIL_EXR_MAX_PIXELS)
         return veil_fail(err, VEIL_ERR_LIMIT, "%s: OpenEXR image %" PRId64 "x%" PRId64 " has more than 2^28 pixels (a "
                          "16384x16384 image, the largest veil renders), the most veil reads", path, w, h);
+    if (req->max_pixels && (uint64_t)w * (uint64_t)h > req->max_pixels) /* the caller's, from the header alone */
+        return veil_fail(err, VEIL_ERR_LIMIT, "%s: OpenEXR image %" PRId64 "x%" PRId64 " has %" PRIu64 " pixels, "
+                         "more than the %" PRIu64 " read here", path, w, h, (uint64_t)w * (uint64_t)h, req->max_pixels);
     size_t bytes = 0;
     if (!veil_mul_sizes((size_t)w, (size_t)h, (size_t)n, sizeof(float), &bytes) ||
         (uint64_t)w > (uint64_t)INT32_MAX / ((size_t)n * sizeof(float)))
@@ -307,7 +336,7 @@ static veil_result read_channels(exr_const_context_t ctx, const char* path, uint
 
     /* each chunk of the image is where the chunk table says, inside the file, before the image is allocated */
     uint64_t too_big = 0;
-    read_target t = {n, req->names, NULL, (int)w, (int)h, dw.min.x, dw.min.y, file_size, &too_big};
+    read_target t = {n, req->names, NULL, (int)w, (int)h, dw.min.x, dw.min.y, file_size, &too_big, req->what};
     veil_result r = read_pixels(ctx, path, storage, &t, msgs, err);
     if (r != VEIL_OK) return r;
 
@@ -394,15 +423,22 @@ static veil_result read_exr_file(const char* fn, const char* path, const read_re
 
 veil_result veil_read_exr(const char* path, int* width, int* height, float** rgba, veil_error* err)
 {
-    const read_request req = {4, veil__exr_rgba_names, 3, VEIL_ERR_IO, " (R, G and B are required)"};
+    const read_request req = {4, veil__exr_rgba_names, 3, VEIL_ERR_IO, " (R, G and B are required)", 0, NULL};
     return read_exr_file("veil_read_exr", path, &req, width, height, rgba, err);
+}
+
+veil_result veil_read_exr_within(const char* path, uint64_t max_pixels, const char* what, int* width, int* height,
+                                 float** rgba, veil_error* err)
+{
+    const read_request req = {4, veil__exr_rgba_names, 3, VEIL_ERR_IO, " (R, G and B are required)", max_pixels, what};
+    return read_exr_file("veil_read_exr_within", path, &req, width, height, rgba, err);
 }
 
 veil_result veil_read_exr_channel(const char* path, const char* name, int* width, int* height, float** plane,
                                   veil_error* err)
 {
     const char* const names[1] = {name};
-    const read_request req = {1, names, -1, VEIL_ERR_INVALID, ""};
+    const read_request req = {1, names, -1, VEIL_ERR_INVALID, "", 0, NULL};
     return read_exr_file("veil_read_exr_channel", path, &req, width, height, plane, err);
 }
 

@@ -78,6 +78,17 @@ veil_result veil_read_exr_channel(const char* path, const char* name, int* width
 veil_result veil_read_exr(const char* path, int* width, int* height,
                           float** rgba, veil_error* err);
 
+/* veil_read_exr of an image of at most max_pixels (0: VEIL_EXR_MAX_PIXELS),
+ * refused from its header alone with VEIL_ERR_LIMIT before any pixel is
+ * read (an environment map, issue 41). With `what` (a short phrase:
+ * "reading sky.exr"), the decoding reports its progress (core/progress.h:
+ * pixels done of all) and honours a cancel between chunks, once
+ * VEIL_EXR_PART_PIXELS more pixels are decoded (VEIL_ERR_CANCELLED, nothing
+ * returned). */
+#define VEIL_EXR_PART_PIXELS ((uint64_t)1 << 20)
+veil_result veil_read_exr_within(const char* path, uint64_t max_pixels, const char* what, int* width, int* height,
+                                 float** rgba, veil_error* err);
+
 /* 8-bit sRGB PNG preview, RGB (no alpha): each pixel's linear colour times
  * 2^exposure, tone-mapped by veil_tonemap(), then sRGB-encoded. */
 veil_result veil_write_png(const char* path, int width, int height,

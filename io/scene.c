@@ -194,10 +194,17 @@ static veil_result load_environment_map(const ctx* c, const jpath* fp, veil_envi
     int w = 0, h = 0;
     float* rgba = NULL;
     veil_error inner = {0};
-    veil_result code = veil_read_exr(env->file, &w, &h, &rgba, &inner);
+    const char* base = strrchr(env->file, '/');
+    char what[160];
+    snprintf(what, sizeof what, "reading %.140s", base ? base + 1 : env->file);
+    /* over VEIL_ENV_MAX_TEXELS refused from the header, before any texel is read (issue 41: a 16384 x 8192
+     * map took 2.1 GB and 20 s before its size was seen) */
+    veil_result code = veil_read_exr_within(env->file, VEIL_ENV_MAX_TEXELS, what, &w, &h, &rgba, &inner);
     if (code != VEIL_OK) {
-        veil_result r = veil__jr_fail_at(c, fp, "cannot read the environment map: %s", inner.msg);
-        return code == VEIL_ERR_OOM || code == VEIL_ERR_LIMIT || code == VEIL_ERR_IO ? code : r;
+        veil_result r = veil__jr_fail_at(c, fp, "cannot read the environment map: %s%s", inner.msg,
+                                         code == VEIL_ERR_LIMIT ? " (an environment map has at most 2^25 texels: "
+                                                                  "8192 x 4096)" : "");
+        return code == VEIL_ERR_OOM || code == VEIL_ERR_LIMIT || code == VEIL_ERR_IO || code == VEIL_ERR_CANCELLED ? code : r;
     }
     if ((size_t)w * (size_t)h > VEIL_ENV_MAX_TEXELS || w < 2 || h < 1) {
         free(rgba);
@@ -316,7 +323,9 @@ static veil_result parse_lights(const ctx* c, const cJSON* root, veil_scene* s)
     s->light_count = n; /* (the environment is one of the VEIL_MAX_LIGHTS entries: n < VEIL_MAX_LIGHTS with it) */
     if (s->environment.present) { /* (at most the room the other lights leave: docs/scene-format.md) */
         static const int rungs[VEIL_ENV_CUTS] = {VEIL_ENV_LIGHTS_DEFAULT, VEIL_ENV_LIGHTS_DRAFT, VEIL_ENV_LIGHTS_HIGH};
-        veil_env_make_cuts(&s->environment, VEIL_MAX_LIGHTS - (int)n, rungs, VEIL_ENV_CUTS);
+        if (veil_env_make_cuts(&s->environment, VEIL_MAX_LIGHTS - (int)n, rungs, VEIL_ENV_CUTS))
+            return veil_fail(c->err, VEIL_ERR_CANCELLED, "%s: cancelled while the environment map was cut into "
+                             "lights", c->name);
     }
     return VEIL_OK;
 }

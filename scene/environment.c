@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "../core/hash.h"
+#include "../core/progress.h"
 #include "../core/shared.glsl.h"
 
 #define ENV_PI 3.14159265358979323846
@@ -115,6 +116,27 @@ typedef struct {
 
 typedef enum { PART_ALL, PART_BRIGHT, PART_REST } env_part;
 
+/* The cuts' work, for their progress reports and a cancel (issue 41: an 8K map's cuts take seconds): texels
+ * visited, reported (core/progress.h) every ENV_PART_TEXELS of them, out of an estimate of all. */
+#define ENV_PART_TEXELS ((size_t)1 << 22)
+typedef struct {
+    size_t done, since;
+    double total;   /* the estimate: the cuts' texel visits (the map's texels x 8 a cut) */
+    int cancelled;  /* set once a report finds the cancel flag: the cuts stop, short */
+} env_work;
+
+static int env_visit(env_work* w, size_t texels)
+{
+    if (!w) return 0;
+    w->done += texels, w->since += texels;
+    if (w->since >= ENV_PART_TEXELS) {
+        w->since = 0;
+        veil_progress("cutting the environment map", fmin((double)w->done, w->total), w->total);
+        w->cancelled = veil_progress_cancelled();
+    }
+    return w->cancelled;
+}
+
 typedef struct {
     int w, h;
     const float* rgb; /* w * h * 3 */
@@ -122,6 +144,7 @@ typedef struct {
     env_part part;    /* the whole map, or its bright part or its rest above and below `clip` */
     double clip;      /* the split's luminance (veil_environment.clip) */
     double* dw;       /* each row's texel solid angle (h values; NULL: computed at each use) */
+    env_work* work;   /* NULL: no reports */
 } env_map;
 
 /* m's rows' solid angles, computed once (a cut walks the map's texels several times); NULL when out of
@@ -159,8 +182,10 @@ static double texel_energy(const env_map* m, int i, int j)
 static double region_energy(const env_map* m, int i0, int i1, int j0, int j1)
 {
     double s = 0.0;
-    for (int j = j0; j < j1; ++j)
+    for (int j = j0; j < j1; ++j) {
         for (int i = i0; i < i1; ++i) s += texel_energy(m, i, j);
+        if (env_visit(m->work, (size_t)(i1 - i0))) break; /* cancelled: the cut is abandoned */
+    }
     return s;
 }
 
@@ -203,6 +228,7 @@ static int region_light(const env_map* m, const veil_environment* e, const env_r
 {
     double c[3] = {0, 0, 0}, d[3] = {0, 0, 0};
     for (int j = r->j0; j < r->j1; ++j) {
+        if (env_visit(m->work, (size_t)(r->i1 - r->i0))) return 0;
         double dw = row_dw(m, j);
         double ct = cos(ENV_PI * (j + 0.5) / m->h);
         for (int i = r->i0; i < r->i1; ++i) {
@@ -231,12 +257,14 @@ static int region_light(const env_map* m, const veil_environment* e, const env_r
 static int lit_box(const env_map* m, const env_region* r, env_region* out)
 {
     int i0 = r->i1, i1 = r->i0, j0 = r->j1, j1 = r->j0;
-    for (int j = r->j0; j < r->j1; ++j)
+    for (int j = r->j0; j < r->j1; ++j) {
         for (int i = r->i0; i < r->i1; ++i)
             if (texel_energy(m, i, j) > 0.0) {
                 i0 = i < i0 ? i : i0, i1 = i + 1 > i1 ? i + 1 : i1;
                 j0 = j < j0 ? j : j0, j1 = j + 1 > j1 ? j + 1 : j1;
             }
+        if (env_visit(m->work, (size_t)(r->i1 - r->i0))) break;
+    }
     if (i0 >= i1) return 0;
     *out = (env_region){i0, i1, j0, j1, r->energy};
     return 1;
@@ -261,7 +289,7 @@ static int cut_regions(const veil_environment* e, const env_map* m, int max, vei
     regions[0] = (env_region){0, m->w, 0, m->h, region_energy(m, 0, m->w, 0, m->h)};
     if (shrink && !lit_box(m, &regions[0], &regions[0])) return 0;
     const double point = VEIL_ENV_POINT_DEG * (ENV_PI / 180.0);
-    while (n < max) {
+    while (n < max && !(m->work && m->work->cancelled)) {
         int pick = -1;
         for (int r = 0; r < n; ++r) /* the region carrying the most light that can still be split */
             if ((regions[r].i1 - regions[r].i0 > 1 || regions[r].j1 - regions[r].j0 > 1) &&
@@ -281,10 +309,10 @@ static int cut_regions(const veil_environment* e, const env_map* m, int max, vei
     return lights;
 }
 
-static int median_cut(const veil_environment* e, env_part part, int max, veil_light* out)
+static int median_cut(const veil_environment* e, env_part part, int max, veil_light* out, env_work* work)
 {
     if (!e || !e->present || !e->rgb || max <= 0) return 0;
-    env_map m = {e->width, e->height, e->rgb, {0, 0, 0}, part, e->clip, NULL};
+    env_map m = {e->width, e->height, e->rgb, {0, 0, 0}, part, e->clip, NULL, work};
     if (e->width == 1 && e->height == 1) { /* a constant sky: cut as a 64 x 32 map of itself */
         m.w = 64, m.h = 32, m.rgb = NULL;
         memcpy(m.one, e->rgb, sizeof m.one);
@@ -297,12 +325,12 @@ static int median_cut(const veil_environment* e, env_part part, int max, veil_li
 
 int veil_env_median_cut(const veil_environment* e, int max, veil_light* out)
 {
-    return median_cut(e, PART_ALL, max, out);
+    return median_cut(e, PART_ALL, max, out, NULL);
 }
 
 int veil_env_bright_cut(const veil_environment* e, int max, veil_light* out)
 {
-    return median_cut(e, PART_BRIGHT, max, out);
+    return median_cut(e, PART_BRIGHT, max, out, NULL);
 }
 
 double veil_env_mean_luminance(const veil_environment* e)
@@ -316,7 +344,7 @@ void veil_env_part_integral(const veil_environment* e, int bright, double out[3]
 {
     out[0] = out[1] = out[2] = 0.0;
     if (!e || !e->present || !e->rgb) return;
-    env_map m = {e->width, e->height, e->rgb, {0, 0, 0}, bright ? PART_BRIGHT : PART_REST, e->clip, NULL};
+    env_map m = {e->width, e->height, e->rgb, {0, 0, 0}, bright ? PART_BRIGHT : PART_REST, e->clip, NULL, NULL};
     for (int j = 0; j < m.h; ++j) {
         double dw = veil_env_texel_solid_angle(m.w, m.h, j);
         for (int i = 0; i < m.w; ++i) {
@@ -346,7 +374,7 @@ veil_result veil_env_rest_table(const veil_environment* e, size_t max_texels, ve
     const int tw = (w + f - 1) / f, th = (h + f - 1) / f;
     float* en = malloc((size_t)tw * th * 8 * sizeof *en);
     if (!en) return veil_fail(err, VEIL_ERR_OOM, "out of memory for the environment's photon table (%dx%d)", tw, th);
-    env_map m = {w, h, e->rgb, {0, 0, 0}, PART_REST, e->clip, NULL};
+    env_map m = {w, h, e->rgb, {0, 0, 0}, PART_REST, e->clip, NULL, NULL};
     double total = 0.0, bound = 0.0;
     int n = 0;
     for (int bj = 0; bj < th; ++bj)
@@ -387,29 +415,32 @@ void veil_env_table_free(veil_env_table* t)
     memset(t, 0, sizeof *t);
 }
 
-void veil_env_make_cuts(veil_environment* e, int room, const int* rungs, int n)
+int veil_env_make_cuts(veil_environment* e, int room, const int* rungs, int n)
 {
     e->cut_sets = 0;
     e->room = room < 0 ? 0 : room > VEIL_MAX_LIGHTS ? VEIL_MAX_LIGHTS : room;
-    if (!e->present) return;
+    if (!e->present) return 0;
     e->clip = VEIL_ENV_CLIP * veil_env_mean_luminance(e);
     uint64_t key = veil_hash_bytes(VEIL_FNV_OFFSET, &e->width, sizeof e->width);
     key = veil_hash_bytes(key, &e->height, sizeof e->height);
     key = veil_hash_bytes(key, &e->rotation_deg, sizeof e->rotation_deg);
     key = veil_hash_bytes(key, &e->up_z, sizeof e->up_z);
     e->key = veil_hash_words(key, e->rgb, (size_t)e->width * e->height * 3 * sizeof *e->rgb);
-    if (e->room == 0) return;
+    if (e->room == 0) return 0;
     const int one = e->lights;
     if (one > 0) rungs = &one, n = 1;
-    for (int r = 0; r < n && e->cut_sets < VEIL_ENV_CUTS; ++r) {
+    env_work work = {.total = 8.0 * 2.0 * n * (double)e->width * (double)e->height};
+    for (int r = 0; r < n && e->cut_sets < VEIL_ENV_CUTS && !work.cancelled; ++r) {
         int k = rungs[r] < e->room ? rungs[r] : e->room, seen = 0;
         for (int c = 0; c < e->cut_sets; ++c) seen |= e->cuts[c].k == k;
         if (seen || k < 1) continue;
         veil_env_cut* cut = &e->cuts[e->cut_sets++];
         cut->k = k;
-        cut->count = veil_env_median_cut(e, k, cut->lights);
-        cut->bright_count = veil_env_bright_cut(e, k, cut->bright);
+        cut->count = median_cut(e, PART_ALL, k, cut->lights, &work);
+        cut->bright_count = median_cut(e, PART_BRIGHT, k, cut->bright, &work);
     }
+    if (work.cancelled) e->cut_sets = 0;
+    return work.cancelled;
 }
 
 const veil_env_cut* veil_env_cut_for(const veil_environment* e, int want)
@@ -447,7 +478,7 @@ veil_result veil_env_dist_make(veil_environment* e, veil_error* err)
         free(d);
         return veil_fail(err, VEIL_ERR_OOM, "out of memory for the environment's sampling tables (%dx%d)", w, h);
     }
-    env_map m = {w, h, e->rgb, {0, 0, 0}, PART_ALL, 0.0, NULL};
+    env_map m = {w, h, e->rgb, {0, 0, 0}, PART_ALL, 0.0, NULL, NULL};
     double total = 0.0;
     for (int j = 0; j < h; ++j)
         for (int i = 0; i < w; ++i) total += texel_energy(&m, i, j);

@@ -149,8 +149,10 @@ veil_result veil_env_rest_table(const veil_environment* e, size_t max_texels, ve
 void veil_env_table_free(veil_env_table* t);
 
 /* Makes e's cuts for `room` lights at most: the one of e->lights, or with lights 0 one for each of the
- * counts rungs[0 .. n) (each at most room; equal ones once). */
-void veil_env_make_cuts(veil_environment* e, int room, const int* rungs, int n);
+ * counts rungs[0 .. n) (each at most room; equal ones once). Reports its progress (core/progress.h,
+ * "cutting the environment map") every 2^22 texels visited; a cancel found there stops it with no cuts,
+ * and it returns 1 (0 otherwise). */
+int veil_env_make_cuts(veil_environment* e, int room, const int* rungs, int n);
 /* The cut for `want` lights (e->lights when set, else the rung's `want`), at most e->room: the kept cut of
  * that count, else the first; NULL without an environment. */
 const veil_env_cut* veil_env_cut_for(const veil_environment* e, int want);

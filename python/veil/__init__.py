@@ -28,6 +28,7 @@ from . import _render
 _cdll, _path = _lib.load()
 _render._Lib.lib = _cdll
 _render._Lib.has_grids = hasattr(_cdll, "veil_scene_set_grid")
+_render._Lib.has_scene_create = hasattr(_cdll, "veil_scene_create")
 
 
 def _numbers():
@@ -38,7 +39,7 @@ def _numbers():
     return tuple(x.value for x in v)
 
 
-#: the loaded library's version (veil_version()), e.g. "0.3.0"
+#: the loaded library's version (veil_version()), e.g. "0.4.0"
 __version__ = _cdll.veil_version().decode()
 #: the same as numbers: (major, minor, patch)
 version_info = _numbers()

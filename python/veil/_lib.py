@@ -79,6 +79,20 @@ class veil_render_desc_0_3(ctypes.Structure):
     ]
 
 
+class veil_scene_desc(ctypes.Structure):
+    """veil 0.4: a scene read with a progress callback (Ctrl-C cancels a long read)."""
+
+    _fields_ = [
+        ("size", ctypes.c_size_t),
+        ("path", ctypes.c_char_p),
+        ("json", ctypes.c_char_p),
+        ("base_dir", ctypes.c_char_p),
+        ("name", ctypes.c_char_p),
+        ("progress", PROGRESS_CALLBACK),
+        ("progress_user", ctypes.c_void_p),
+    ]
+
+
 class veil_grid_desc(ctypes.Structure):
     _fields_ = [
         ("size", ctypes.c_size_t),
@@ -105,6 +119,7 @@ _PROTOTYPES = {
     "veil_scene_open": (_c.c_int32, [_c.c_char_p, _PP, _ERR]),
     "veil_scene_from_json": (_c.c_int32, [_c.c_char_p, _c.c_char_p, _c.c_char_p, _PP, _ERR]),
     "veil_scene_close": (None, [_P]),
+    "veil_scene_create": (_c.c_int32, [_c.POINTER(veil_scene_desc), _PP, _ERR]),
     "veil_scene_set_grid": (_c.c_int32, [_P, _c.c_char_p, _c.POINTER(veil_grid_desc), _ERR]),
     "veil_render": (_c.c_int32, [_P, _P, _P, _PP, _ERR]),  # desc: a pointer to either layout
     "veil_image_size": (None, [_P, _c.POINTER(_c.c_int), _c.POINTER(_c.c_int)]),
@@ -120,7 +135,7 @@ _PROTOTYPES = {
     ),
     "veil_image_destroy": (None, [_P]),
 }
-_OPTIONAL = {"veil_scene_set_grid"}  # veil 0.3 on
+_OPTIONAL = {"veil_scene_set_grid", "veil_scene_create"}  # veil 0.3 on, veil 0.4 on
 
 
 # ---- finding the library -------------------------------------------------

@@ -10,7 +10,8 @@ import numpy as np
 
 from . import _grids, _progress, _scene
 from ._errors import Cancelled, VeilError, raise_for
-from ._lib import RESULT_CODES, veil_context_desc, veil_error, veil_render_desc_0_2, veil_render_desc_0_3
+from ._lib import (RESULT_CODES, veil_context_desc, veil_error, veil_render_desc_0_2, veil_render_desc_0_3,
+                   veil_scene_desc)
 
 # image channels, as veil_image_channel names them, grouped into the arrays render() returns
 _AOVS = (
@@ -54,6 +55,7 @@ class _Lib:
     lib = None
     has_grids = False
     has_progress = False
+    has_scene_create = False
 
 
 def _err():
@@ -164,8 +166,64 @@ def close_default_context():
 
 # ---- one scene handle with its grids ---------------------------------------
 
+def _raise_from_bridge(bridge, code, err):
+    """After a veil call with a progress bridge: the callback's own exception (or Ctrl-C's) with veil's
+    error as its context, or veil.Cancelled when it returned False; else nothing."""
+    lib = _Lib.lib
+    if bridge.interrupted and bridge.raised is None:
+        bridge.raised = KeyboardInterrupt()
+    if bridge.raised is not None:
+        exc = bridge.raised
+        try:
+            if code != 0:
+                raise_for(lib, code, err)
+        except VeilError as veil_exc:
+            exc.__context__ = veil_exc
+        raise exc
+    if code == 0 and bridge.cancelled:
+        # cancelled at the very end: veil made the result anyway; what was asked is honoured
+        raise Cancelled(RESULT_CODES["VEIL_ERR_CANCELLED"], "the progress callback returned False")
+
+
+def _open_scene(st, progress):
+    """veil_scene_create (veil 0.4: Ctrl-C and progress returning False cancel a long read, such as an 8K
+    environment map's), else veil_scene_open / veil_scene_from_json. The callable progress sees the read
+    as the inject stage at 0 (veil.STAGES has no stage of its own for it)."""
+    lib = _Lib.lib
+    handle = ctypes.c_void_p()
+    err = _err()
+    if _Lib.has_scene_create:
+        fn = progress if callable(progress) else None
+        bridge = _progress.Bridge((lambda stage, done: fn("inject", 0.0)) if fn is not None else None)
+        desc = veil_scene_desc()
+        desc.size = ctypes.sizeof(desc)
+        if st.path is not None:
+            desc.path = os.fsencode(st.path)
+        else:
+            desc.json = st.text.encode("utf-8")
+            desc.base_dir = os.fsencode(st.base_dir) if st.base_dir is not None else None
+            desc.name = st.name.encode("utf-8")
+        desc.progress = bridge.c_callback
+        with bridge.interrupts():
+            code = lib.veil_scene_create(ctypes.byref(desc), ctypes.byref(handle), ctypes.byref(err))
+        try:
+            _raise_from_bridge(bridge, code, err)
+        except BaseException:
+            if code == 0:
+                lib.veil_scene_close(handle)
+            raise
+    elif st.path is not None:
+        code = lib.veil_scene_open(os.fsencode(st.path), ctypes.byref(handle), ctypes.byref(err))
+    else:
+        code = lib.veil_scene_from_json(st.text.encode("utf-8"),
+                                        os.fsencode(st.base_dir) if st.base_dir is not None else None,
+                                        st.name.encode("utf-8"), ctypes.byref(handle), ctypes.byref(err))
+    _check(code, err)
+    return handle
+
+
 class _Scene:
-    def __init__(self, scene, grids, quality, base_dir):
+    def __init__(self, scene, grids, quality, base_dir, progress=None):
         lib = _Lib.lib
         self.handle = None
         st = _scene.prepare(scene, quality, base_dir)
@@ -176,16 +234,8 @@ class _Scene:
             raise VeilError(RESULT_CODES["VEIL_ERR_INVALID"],
                             "grids: the loaded libveil.so (veil %s) has no veil_scene_set_grid: grids from memory "
                             "need veil 0.3 or later" % lib.veil_version().decode())
-        handle = ctypes.c_void_p()
+        self.handle = _open_scene(st, progress)
         err = _err()
-        if st.path is not None:
-            code = lib.veil_scene_open(os.fsencode(st.path), ctypes.byref(handle), ctypes.byref(err))
-        else:
-            code = lib.veil_scene_from_json(st.text.encode("utf-8"),
-                                            os.fsencode(st.base_dir) if st.base_dir is not None else None,
-                                            st.name.encode("utf-8"), ctypes.byref(handle), ctypes.byref(err))
-        _check(code, err)
-        self.handle = handle
         if st.unparsed is not None:  # veil read it; Python's json could not, so the override was not applied
             self.close()
             raise VeilError(RESULT_CODES["VEIL_ERR_PARSE"],
@@ -350,20 +400,8 @@ def _render_one(ctx, scn, width, height, seed, step_voxels, frame, frames, progr
         if close_bar is not None:
             close_bar()
     try:
-        if bridge is not None and bridge.interrupted and bridge.raised is None:
-            bridge.raised = KeyboardInterrupt()
-        if bridge is not None and bridge.raised is not None:
-            # the callback's own exception (or Ctrl-C's), with veil's Cancelled as its context
-            exc = bridge.raised
-            try:
-                if code != 0:
-                    raise_for(lib, code, err)
-            except VeilError as veil_exc:
-                exc.__context__ = veil_exc
-            raise exc
-        if code == 0 and bridge is not None and (bridge.cancelled):
-            # cancelled at the very end: veil made the image anyway; what was asked is honoured
-            raise Cancelled(RESULT_CODES["VEIL_ERR_CANCELLED"], "the progress callback returned False")
+        if bridge is not None:
+            _raise_from_bridge(bridge, code, err)
         _check(code, err)
         out = _image_arrays(img, aovs)
         out.frame = frame
@@ -434,7 +472,7 @@ def render(scene, grids=None, quality=None, size=None, seed=0, step_voxels=None,
     frame = _number("frame", frame, 0, max(frames - 1, 0), integer=True)
     _check_output(output)
     _progress.check(progress)
-    scn = _Scene(scene, grids, quality, base_dir)  # a bad scene is reported before any GL work
+    scn = _Scene(scene, grids, quality, base_dir, progress)  # a bad scene is reported before any GL work
     try:
         ctx = context if context is not None else default_context()
         return _render_one(ctx, scn, width, height, int(seed), step, int(frame), int(frames), progress, output,
@@ -485,7 +523,7 @@ def turntable(scene, frames, grids=None, quality=None, size=None, seed=0, step_v
 
 def _turntable(ctx, scene, grids, quality, base_dir, width, height, seed, step, frames, start, stop, progress,
                output, aovs, exposure):
-    scn = _Scene(scene, grids, quality, base_dir)
+    scn = _Scene(scene, grids, quality, base_dir, progress)
     try:
         ctx = ctx if ctx is not None else default_context()
         for f in range(start, stop):

@@ -10,8 +10,12 @@
  *    every call), a re-entry is VEIL_ERR_INVALID, a destroyed context
  *    ends the render with VEIL_ERR_INVALID and is released (no signal, no
  *    read of freed memory: test-sanitize runs this under ASan);
- *  - item 9: veil_scene_set_grid refuses voxels under VEIL_GRID_MIN_VOXEL
- *    and placements beyond the scene's coordinate bound, naming the grid.
+ *  - item 7: veil_scene_create reads a 2048 x 1024 map (make_env_map,
+ *    argv[1]) with its progress: the stage "scene", the share never going
+ *    back, reports while the map is decoded and while it is cut; a cancel
+ *    asked for at the first report of either ends the read there
+ *    (VEIL_ERR_CANCELLED, no report after, no scene); a bad description is
+ *    refused naming the field.
  * Exit 77 (skipped) when no GL context can be made, except under CI=true. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -117,6 +121,66 @@ static void writers_spare_inputs(veil_context* ctx)
     veil_image_destroy(img);
     veil_scene_close(s);
     remove(other), remove(sky_link), remove(scene_link), remove(scene_path), remove(sky);
+}
+
+/* ---- item 7 ---------------------------------------------------------------- */
+
+typedef struct read_log {
+    int reports, cut_reports, after, cancel_at_cut, cancel_at;
+    double done;
+    int bad;
+} read_log;
+
+static int on_read(void* user, const char* stage, double done)
+{
+    read_log* l = user;
+    if (l->cancel_at && l->reports >= l->cancel_at) ++l->after;
+    if (strcmp(stage, "scene") != 0 || !(done >= l->done && done <= 1.0)) ++l->bad;
+    l->done = done;
+    ++l->reports;
+    if (done > 0.25) ++l->cut_reports; /* the cut's reports: the last three quarters (frame/api.c) */
+    if (l->cancel_at_cut && done > 0.25 && !l->cancel_at) l->cancel_at = l->reports;
+    return l->cancel_at && l->reports == l->cancel_at;
+}
+
+static void scene_read_cancel(const char* make_env_map)
+{
+    char map[256], cmd[1024];
+    path_in(map, sizeof map, "sky.exr");
+    snprintf(cmd, sizeof cmd, "'%s' '%s' 2048 1024", make_env_map, map);
+    CHECK(system(cmd) == 0, "%s failed", cmd);
+    char json[1024];
+    snprintf(json, sizeof json, "{\"camera\": {\"position\": [0, 0, 3], \"look_at\": [0, 0, 0]}, \"medium\": "
+             "{\"sigma_s\": [1, 1, 1], \"sources\": []}, \"lights\": [{\"type\": \"environment\", \"file\": "
+             "\"sky.exr\"}]}");
+    veil_scene_desc d = VEIL_SCENE_DESC_INIT;
+    d.json = json, d.base_dir = g_dir, d.name = "sky", d.progress = on_read;
+    veil_error err = {{0}};
+    for (int how = 0; how < 3; ++how) { /* read whole; cancelled at the first report; at the cut's first */
+        read_log log = {.cancel_at = how == 1, .cancel_at_cut = how == 2};
+        d.progress_user = &log;
+        veil_scene* s = NULL;
+        veil_result r = veil_scene_create(&d, &s, &err);
+        if (how == 0) {
+            printf("scene read: %d reports, %d while cutting\n", log.reports, log.cut_reports);
+            CHECK(r == VEIL_OK && s && !log.bad && log.reports - log.cut_reports >= 2 && log.cut_reports >= 2,
+                  "read with progress: %s: %s; %d reports (%d cutting), %d bad", veil_result_name(r), err.msg,
+                  log.reports, log.cut_reports, log.bad);
+        } else {
+            CHECK(r == VEIL_ERR_CANCELLED && !s && log.after == 0 && !log.bad &&
+                      strstr(err.msg, how == 1 ? "cancelled while its pixels were read" : "cancelled while the "
+                             "environment map was cut"),
+                  "cancel %d: %s: %s; %d reports after", how, veil_result_name(r), err.msg, log.after);
+        }
+        veil_scene_close(s);
+    }
+    /* the description: exactly one of path and json */
+    veil_scene_desc both = d;
+    both.path = map;
+    veil_scene* s = NULL;
+    CHECK(veil_scene_create(&both, &s, &err) == VEIL_ERR_INVALID && !s && strstr(err.msg, "exactly one of"),
+          "path and json: %s", err.msg);
+    remove(map);
 }
 
 /* ---- item 3 ---------------------------------------------------------------- */
@@ -253,10 +317,15 @@ static void callbacks_touching_contexts(void)
     veil_scene_close(s);
 }
 
-int main(void)
+int main(int argc, char** argv)
 {
+    if (argc != 2) {
+        fprintf(stderr, "usage: test_api_hostile MAKE_ENV_MAP\n");
+        return 2;
+    }
     veil_context* ctx = context_or_skip();
     if (test_dir_begin("api_hostile")) {
+        scene_read_cancel(argv[1]);
         writers_spare_inputs(ctx);
         callbacks_touching_contexts();
         CHECK(test_dir_end(), "temporary folder left clean");

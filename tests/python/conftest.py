@@ -21,6 +21,7 @@ sys.path.insert(0, os.path.join(REPO, "python"))
 if not os.environ.get("VEIL_LIBRARY") and os.path.exists(os.path.join(REPO, "build", "libveil.so")):
     os.environ["VEIL_LIBRARY"] = os.path.join(REPO, "build", "libveil.so")
 os.environ.setdefault("VEIL_CLI", os.path.join(REPO, "build", "veil"))
+os.environ.setdefault("VEIL_MAKE_ENV_MAP", os.path.join(REPO, "build", "tests", "make_env_map"))
 
 import veil  # noqa: E402  (after the path set-up above)
 

@@ -2,6 +2,8 @@
 back out, no file written by a cancelled render and an existing one left as it was."""
 
 import importlib.util
+import os
+import subprocess
 
 import numpy as np
 import pytest
@@ -148,3 +150,29 @@ def test_callbacks_that_touch_contexts(gl, progress_api, stage):
                 np.testing.assert_array_equal(ctx.render(s, seed=3, progress=progress)["rgba"], truth)
             assert seen, "the callback never reached %s" % stage
             np.testing.assert_array_equal(ctx.render(s, seed=3)["rgba"], truth)  # and it renders on
+
+
+def test_ctrl_c_cancels_a_long_scene_read(gl, progress_api, tmp_path):
+    """Issue 41, item 7: reading an environment map (decoded, then cut into lights) reports to the progress
+    callback as the inject stage at 0, so Ctrl-C (here SIGINT sent from the first report) cancels the read
+    itself: KeyboardInterrupt, with veil's VEIL_ERR_CANCELLED from the scene read as its context. Before,
+    the read ran to its end (an 8K map: ~30 s) before Python saw the signal."""
+    import signal
+    tool = os.environ["VEIL_MAKE_ENV_MAP"]
+    assert os.access(tool, os.X_OK), "VEIL_MAKE_ENV_MAP=%s: no such tool (ctest sets it)" % tool
+    subprocess.run([tool, str(tmp_path / "sky.exr"), "2048", "1024"], check=True)
+    s = fresh_scene(505)
+    s["lights"].append({"type": "environment", "file": "sky.exr"})
+    seen = []
+
+    def progress(stage, done):
+        seen.append((stage, done))
+        if len(seen) == 1:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    with pytest.raises(KeyboardInterrupt) as e:
+        veil.render(s, base_dir=tmp_path, progress=progress)
+    ctx = e.value.__context__
+    assert isinstance(ctx, veil.VeilError) and ctx.name == "VEIL_ERR_CANCELLED", repr(ctx)
+    assert "environment map" in ctx.message or "pixels were read" in ctx.message, ctx.message
+    assert seen[0] == ("inject", 0.0) and len(seen) <= 2, seen
