@@ -13,6 +13,7 @@
 
 struct veil_renderer {
     unsigned long long memory_budget; /* bytes, see veil_gl_info */
+    int hardware;                     /* veil_gl_info's: a software rasteriser marches in shorter bands */
     veil_frame_parts parts;           /* the stages' GPU objects and the keys of what they hold */
     int ready;                        /* 1: the GL context and the stages' objects are made */
     veil_gl* own_gl;                  /* a deferred renderer's context, made by it and destroyed with it */
@@ -25,8 +26,10 @@ struct veil_renderer {
 static veil_result make_parts(veil_renderer* r, const veil_gl* gl, veil_error* err)
 {
     r->memory_budget = veil_gl_get_info(gl)->memory_budget;
+    r->hardware = veil_gl_get_info(gl)->hardware;
     veil_frame_parts* p = &r->parts;
     veil_result res = veil_ev_create(&p->ev, err);
+    if (res == VEIL_OK) veil_ev_set_software(p->ev, !r->hardware);
     if (res == VEIL_OK) res = veil_opv_set_create(&p->opv, err);
     if (res == VEIL_OK) res = veil_volumetric_create(&p->volumetric, err);
     if (res == VEIL_OK) res = veil_march_create(&p->march, err);
@@ -69,6 +72,7 @@ static veil_result make_gpu(veil_frame* f, veil_error* err)
         if (res != VEIL_OK) return res;
     }
     f->plan.budget = r->memory_budget;
+    f->plan.hardware = r->hardware;
     return VEIL_OK;
 }
 

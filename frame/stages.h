@@ -110,6 +110,7 @@ typedef struct veil_frame_plan {
     veil_render_opts o;             /* resolved (veil_render_opts_resolve) */
     int fogs;                       /* analytic fogs (closed form, never voxelised) */
     unsigned long long budget;      /* the device's memory budget (bytes); 0 when explaining */
+    int hardware;                   /* the device is not a software rasteriser (veil_gl_info); 0 when explaining */
     /* the density given on a grid instead of the scene's sources (veil_render_density); NULL: the sources */
     const veil_grid* given_grid;
     const float* given_density;

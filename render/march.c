@@ -197,9 +197,9 @@ static veil_result image(int w, int h, const char* label, GLuint* tex, veil_erro
     return veil_gl_check(label, err);
 }
 
-static uint64_t g_band_work = VEIL_MARCH_DISPATCH_WORK, g_light_list_work = VEIL_MARCH_LIGHT_LIST_WORK;
+static uint64_t g_band_work = 0, g_light_list_work = VEIL_MARCH_LIGHT_LIST_WORK; /* g_band_work 0: the desc's */
 
-void veil_march_set_dispatch_work(uint64_t work) { g_band_work = work ? work : VEIL_MARCH_DISPATCH_WORK; }
+void veil_march_set_dispatch_work(uint64_t work) { g_band_work = work; }
 
 void veil_march_set_light_list_work(uint64_t work) { g_light_list_work = work ? work : VEIL_MARCH_LIGHT_LIST_WORK; }
 
@@ -214,15 +214,27 @@ static double row_work(const veil_march_desc* d, int w)
         const double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
         steps += sqrt(dx * dx + dy * dy + dz * dz) / ((double)d->step_voxels * lm->grid->voxel);
     }
-    for (size_t i = 0; i < lm->scene->medium.source_count; ++i)
-        if (lm->scene->medium.sources[i].type == VEIL_SOURCE_EXPONENTIAL) steps += 64.0;
+    for (size_t i = 0; i < lm->scene->medium.source_count; ++i) {
+        const veil_source* src = &lm->scene->medium.sources[i];
+        if (src->type != VEIL_SOURCE_EXPONENTIAL) continue;
+        steps += 64.0; /* steps growing by VEIL_FOG_STEP_FRACTION of the distance */
+        /* and near each point or spot light inside it, steps of a quarter of the distance to it */
+        for (int l = 0; l < lm->light_count; ++l) {
+            const veil_light* li = &lm->lights[l];
+            int inside = li->type != VEIL_LIGHT_DIRECTIONAL;
+            for (int a = 0; a < 3 && inside; ++a)
+                inside = li->position[a] >= src->fog.bounds[0][a] && li->position[a] <= src->fog.bounds[1][a];
+            if (inside) steps += 64.0;
+        }
+    }
     return (double)w * steps * (1.0 + lm->light_count);
 }
 
 int veil_march_band_rows(const veil_march_desc* d, int w, int h)
 {
     const double per_row = row_work(d, w);
-    double rows = floor((double)g_band_work / per_row / VEIL_MARCH_GROUP) * VEIL_MARCH_GROUP;
+    const uint64_t work = g_band_work ? g_band_work : d->band_work ? d->band_work : VEIL_MARCH_DISPATCH_WORK;
+    double rows = floor((double)work / per_row / VEIL_MARCH_GROUP) * VEIL_MARCH_GROUP;
     if (rows < VEIL_MARCH_GROUP) rows = VEIL_MARCH_GROUP;
     return rows >= h ? h : (int)rows;
 }

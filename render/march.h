@@ -33,8 +33,16 @@
  * a dense volume is 10^11 steps. At 10^9 to 10^10 steps a second (a
  * desktop GPU) a band takes 0.03 to 0.3 s; on llvmpipe bands only add
  * progress reports. The estimate of steps a ray: the volume box's diagonal
- * over the step, plus 64 a fog. */
+ * over the step, plus 64 a fog and 64 more for each point or spot light in
+ * a fog (its steps shrink to a quarter of the distance to a light). */
 #define VEIL_MARCH_DISPATCH_WORK ((uint64_t)1 << 28)
+/* On a software rasteriser (llvmpipe marches 6e7 units a second on this
+ * project's 2-core machines: the demo's 3.2e8 in 5 s) a band is also the
+ * time a cancel waits (issue 41: within 1 s): 2^24 units, about 0.3 s
+ * (0.8 s where the estimate is low: a fog's steps; docs/performance.md,
+ * "Cancel"). The bands' own cost there is nil: llvmpipe runs each
+ * dispatch as it comes. */
+#define VEIL_MARCH_SOFTWARE_WORK ((uint64_t)1 << 24)
 
 /* A frame whose estimated work (as VEIL_MARCH_DISPATCH_WORK counts it) is at
  * least this gets a march compiled for its lights (VEIL_LIGHT_LIST: each
@@ -75,6 +83,7 @@ typedef struct veil_march_desc {
                                   longest / gather_cells of the cache's a side); 0: VEIL_GATHER_MAX_CELLS */
     int deep_raw;              /* > 0: raw deep samples a pixel (render/deep.h), read into the image set's
                                   deep image (the march compiled with VEIL_MARCH_DEEP); 0: none */
+    uint64_t band_work;        /* a band's work (VEIL_MARCH_DISPATCH_WORK, or _SOFTWARE_WORK); 0: the first */
 } veil_march_desc;
 
 /* What the last veil_march_run gathered (render/shaders/cache_gather.comp): rays 0 when it did not. */
@@ -98,7 +107,7 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
 /* The rows of a band for d at w x h (a multiple of VEIL_MARCH_GROUP, or h). */
 int veil_march_band_rows(const veil_march_desc* d, int w, int h);
 
-/* Tests: the work budget of a band (0: VEIL_MARCH_DISPATCH_WORK again). */
+/* Tests: the work budget of a band, over the desc's (0: the desc's again). */
 void veil_march_set_dispatch_work(uint64_t work);
 
 /* Tests: the work from which a frame's march is compiled for its lights (0: VEIL_MARCH_LIGHT_LIST_WORK
