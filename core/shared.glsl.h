@@ -255,7 +255,7 @@ VEIL_STRUCT_END(veil_sparse_block)
  * (volume/shaders/occupancy.comp) read the grid from this block. */
 #define VEIL_UBO_GRID 5
 VEIL_STRUCT_BEGIN(veil_grid_block)
-    VEIL_IV4(dims);   /* xyz: the EV's voxels; w: the splat: this dispatch's first layer of bricks */
+    VEIL_IV4(dims);   /* xyz: the EV's voxels; w: the splat: this dispatch's first brick (x fastest) */
     VEIL_IV4(bricks); /* xyz: VEIL_BRICK^3 bricks per axis; w: - */
     VEIL_V4(origin);  /* xyz: the grid's min corner (m); w: voxel edge (m) */
 VEIL_STRUCT_END(veil_grid_block)

@@ -17,7 +17,22 @@ struct veil_ev {
     veil_light lights[VEIL_MAX_LIGHTS]; /* the emission as lights */
     int light_count;
     veil_grid grid;
+    size_t splat_evals; /* the splat's dispatches' work (volume/volume.h; 0: VEIL_SPLAT_DISPATCH_EVALS) */
 };
+
+static size_t g_splat_evals; /* tests' override (0: none) */
+
+void veil_ev_set_software(veil_ev* ev, int software)
+{
+    ev->splat_evals = software ? VEIL_SPLAT_SOFTWARE_EVALS : VEIL_SPLAT_DISPATCH_EVALS;
+}
+
+void veil_ev_set_splat_evals(size_t evals) { g_splat_evals = evals; }
+
+static size_t splat_evals(const veil_ev* ev)
+{
+    return g_splat_evals ? g_splat_evals : ev->splat_evals ? ev->splat_evals : VEIL_SPLAT_DISPATCH_EVALS;
+}
 
 veil_result veil_ev_create(veil_ev** out, veil_error* err)
 {
@@ -268,7 +283,7 @@ veil_result veil_ev_build_scene(veil_ev* ev, const veil_scene_volume* v, int n_l
     }
     size_t n = v->particle_count;
     if (r == VEIL_OK && n > 0) r = veil_rbf_bin(g, v->particles, n, &bins, err);
-    if (r == VEIL_OK && n > 0) r = veil_inject_rbf_gpu(ev->inject, g, &bins, ev->tex, err);
+    if (r == VEIL_OK && n > 0) r = veil_inject_rbf_gpu(ev->inject, g, &bins, ev->tex, splat_evals(ev), err);
     if (r == VEIL_OK) r = build_occupancy(ev, err);
     float* emission = NULL;
     if (r == VEIL_OK) r = veil_scene_volume_emission(v, &emission, err);
@@ -315,7 +330,7 @@ veil_result veil_ev_splat_readback(veil_ev* ev, const veil_grid* g, const veil_p
     if (r == VEIL_OK) {
         static const GLfloat zero = 0.0f;
         glClearTexImage(tex, 0, GL_RED, GL_FLOAT, &zero);
-        r = veil_inject_rbf_gpu(ev->inject, g, &bins, tex, err);
+        r = veil_inject_rbf_gpu(ev->inject, g, &bins, tex, splat_evals(ev), err);
     }
     if (r == VEIL_OK) r = veil_gl_read_texture(tex, GL_RED, veil_grid_voxels(g), density, "reading back the EV", err);
     glDeleteTextures(1, &tex);

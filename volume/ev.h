@@ -57,6 +57,10 @@ const veil_ev_sparse* veil_ev_sparse_of(const veil_ev* ev);
 void veil_ev_sparse_bind(const veil_ev_sparse* sp);
 
 veil_result veil_ev_create(veil_ev** out, veil_error* err); /* compiles the inject and occupancy programs */
+/* The device is a software rasteriser: the RBF splat goes in shorter dispatches (volume/volume.h). */
+void veil_ev_set_software(veil_ev* ev, int software);
+/* Tests: every splat's dispatches of at most `evals` evaluations (0: the device's again). */
+void veil_ev_set_splat_evals(size_t evals);
 void veil_ev_destroy(veil_ev* ev);                          /* accepts NULL */
 
 /* Drops the volume (an empty medium: no texture at all). */

@@ -6,7 +6,7 @@
 #include "../gpu/gl_util.h"
 
 veil_result veil_inject_rbf_gpu(GLuint program, const veil_grid* g, const veil_rbf_bins* b,
-                                GLuint ev_texture, veil_error* err)
+                                GLuint ev_texture, size_t dispatch_evals, veil_error* err)
 {
     size_t nb = (size_t)b->bricks[0] * b->bricks[1] * b->bricks[2];
     GLuint buf[3] = {0, 0, 0}, block = 0;
@@ -29,43 +29,49 @@ veil_result veil_inject_rbf_gpu(GLuint program, const veil_grid* g, const veil_r
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_BRICK_START, buf[1]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_BRICK_LIST, buf[2]);
         glBindImageTexture(VEIL_IMAGE_EV, ev_texture, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
-        /* layers of bricks, as many per dispatch as keep its particle-voxel evaluations under
-         * VEIL_SPLAT_DISPATCH_EVALS (a GPU watchdog stops a dispatch of a few seconds; each
-         * layer alone is under it whenever the whole splat is under VEIL_SPLAT_MAX_EVALS) */
-        size_t layer = (size_t)b->bricks[0] * (size_t)b->bricks[1];
-        const double all = (double)b->list_len * VEIL_BRICK * VEIL_BRICK * VEIL_BRICK;
+        /* runs of bricks in their (CSR) order, as many a dispatch as keep its particle-voxel evaluations
+         * under dispatch_evals (a GPU watchdog stops a dispatch of a few seconds; on a software rasteriser
+         * a dispatch is also how late a cancel is seen), one brick at least, at most the work groups a
+         * dispatch may count along x (GL guarantees 65535; 8 a brick: inject_rbf.comp) */
+        const size_t nb_all = nb, per_brick = VEIL_BRICK * VEIL_BRICK * VEIL_BRICK, most = 65535 / 8;
+        const size_t cap = dispatch_evals / per_brick; /* list entries a dispatch */
+        const double all = (double)b->list_len * per_brick;
         double done = 0.0;
         const int report = veil_progress_wanted();
         if (report) veil_progress("RBF splat", 0.0, all);
-        int z = 0;
-        while (z < b->bricks[2]) {
-            int z1 = z;
-            size_t work = 0;
-            do {
-                work += (size_t)(b->start[layer * (size_t)(z1 + 1)] - b->start[layer * (size_t)z1]) *
-                        VEIL_BRICK * VEIL_BRICK * VEIL_BRICK;
-                ++z1;
-            } while (z1 < b->bricks[2] &&
-                     work + (size_t)(b->start[layer * (size_t)(z1 + 1)] - b->start[layer * (size_t)z1]) *
-                                VEIL_BRICK * VEIL_BRICK * VEIL_BRICK <= VEIL_SPLAT_DISPATCH_EVALS);
-            blk.dims[3] = z; /* this dispatch's first layer */
+        size_t k = 0;
+        while (k < nb_all) {
+            /* the last k1 in (k, k + most] whose entries from k fit the cap (k + 1 whatever it holds) */
+            size_t lo = k + 1, hi = k + most < nb_all ? k + most : nb_all;
+            while (lo < hi) {
+                const size_t mid = lo + (hi - lo + 1) / 2;
+                if ((size_t)(b->start[mid] - b->start[k]) <= cap) lo = mid;
+                else hi = mid - 1;
+            }
+            const size_t k1 = lo;
+            blk.dims[3] = (int)k; /* this dispatch's first brick */
             glNamedBufferSubData(block, 0, sizeof blk.dims, blk.dims);
-            glDispatchCompute((GLuint)b->bricks[0], (GLuint)b->bricks[1], (GLuint)(z1 - z));
+            glDispatchCompute((GLuint)(8 * (k1 - k)), 1, 1);
             glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                             GL_TEXTURE_UPDATE_BARRIER_BIT);
             glFlush();
-            z = z1;
-            done += (double)work;
+            done += (double)(b->start[k1] - b->start[k]) * per_brick;
+            k = k1;
             if (report) { /* what is reported is done: the dispatch is finished first */
                 glFinish();
                 veil_progress("RBF splat", done, all);
+                if (veil_progress_cancelled() && k < nb_all) {
+                    r = veil_fail(err, VEIL_ERR_CANCELLED, "cancelled by the progress callback during the RBF "
+                                  "splat (%.3g of %.3g evaluations done)", done, all);
+                    break;
+                }
             }
         }
         for (GLuint i = 0; i < 3; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_PARTICLES + i, 0);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_GRID, 0);
         glBindImageTexture(VEIL_IMAGE_EV, 0, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
         glUseProgram(0);
-        r = veil_gl_check("RBF splat dispatch (volume/shaders/inject_rbf.comp)", err);
+        if (r == VEIL_OK) r = veil_gl_check("RBF splat dispatch (volume/shaders/inject_rbf.comp)", err);
     }
     glDeleteBuffers(3, buf);
     glDeleteBuffers(1, &block);

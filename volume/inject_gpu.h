@@ -8,7 +8,13 @@
 
 #include "volume.h"
 
+/* In dispatches of at most dispatch_evals particle-voxel evaluations
+ * (VEIL_SPLAT_DISPATCH_EVALS on a GPU, VEIL_SPLAT_SOFTWARE_EVALS on a
+ * software rasteriser: volume/volume.h), runs of bricks in their order (at
+ * least one); with a progress sink each is finished and reported, and a cancel
+ * found there stops the splat (VEIL_ERR_CANCELLED, the texture partly
+ * made). */
 veil_result veil_inject_rbf_gpu(GLuint program, const veil_grid* g, const veil_rbf_bins* bins,
-                                GLuint ev_texture, veil_error* err);
+                                GLuint ev_texture, size_t dispatch_evals, veil_error* err);
 
 #endif

@@ -55,15 +55,20 @@ typedef struct veil_rbf_bins {
 
 /* The splat's work, known once the particles are binned: every voxel of a
  * brick evaluates every particle of its list, 512 x (list entries)
- * Gaussians. Above VEIL_SPLAT_MAX_EVALS (about half a minute on a CPU
- * driver at ~1e9 a second; 10^7 particles of a few bricks each come to
- * ~1e11) the bin is refused with the numbers, before any memory is taken
- * for the lists; VEIL_SPLAT_MAX_ENTRIES bounds the lists' memory (1 GiB).
+ * Gaussians. Above VEIL_SPLAT_MAX_EVALS (10^7 particles of a few bricks
+ * each come to ~1e11) the bin is refused with the numbers, before any
+ * memory is taken for the lists; VEIL_SPLAT_MAX_ENTRIES bounds the lists'
+ * memory (1 GiB). llvmpipe splats 2e8 evaluations a second on this
+ * project's 2-core machines (10^6 particles, 9.4e9 evaluations, in 46 s),
+ * so the cap is about 3 minutes there (a desktop GPU: about a second).
  * The GPU splat is split into dispatches of at most VEIL_SPLAT_DISPATCH_EVALS
- * (a brick layer more when one layer holds more). */
+ * (runs of bricks; one brick more when one brick holds more); on a software rasteriser
+ * of VEIL_SPLAT_SOFTWARE_EVALS, each also how late a cancel is seen there
+ * (issue 41: within 1 s): 2^25, about 0.2 s. */
 #define VEIL_SPLAT_MAX_EVALS ((size_t)1 << 35)
 #define VEIL_SPLAT_MAX_ENTRIES ((size_t)1 << 28)
 #define VEIL_SPLAT_DISPATCH_EVALS ((size_t)1 << 28)
+#define VEIL_SPLAT_SOFTWARE_EVALS ((size_t)1 << 25)
 
 veil_result veil_rbf_bin(const veil_grid* g, const veil_particle* p, size_t n,
                          veil_rbf_bins* out, veil_error* err);

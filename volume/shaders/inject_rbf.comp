@@ -1,11 +1,14 @@
 // veil — RBF splat into the extinction volume (density, r32f), added to
 // what the volume holds (zero, or density from other sources).
-// One work group per VEIL_BRICK^3 brick; each invocation is one voxel and
+// Eight work groups per VEIL_BRICK^3 brick, one an octant of it (a software
+// rasteriser runs a work group on one thread: a dispatch of a few crowded
+// bricks still keeps every thread busy); each invocation is one voxel and
 // adds the Gaussians of its brick's particle list, in list order. Mirrors
 // veil_inject_rbf_cpu() operation for operation; `precise` forbids fused
 // multiply-adds so that the cut-off test r^2 <= r_cut^2 decides exactly as
 // in C.
-layout(local_size_x = VEIL_BRICK, local_size_y = VEIL_BRICK, local_size_z = VEIL_BRICK) in;
+#define HALF_BRICK (VEIL_BRICK / 2)
+layout(local_size_x = HALF_BRICK, local_size_y = HALF_BRICK, local_size_z = HALF_BRICK) in;
 
 struct Particle {
     vec4 center_amp;  // centre (m), amplitude
@@ -16,13 +19,18 @@ layout(std430, binding = VEIL_BIND_BRICK_START) readonly buffer BrickStart { uin
 layout(std430, binding = VEIL_BIND_BRICK_LIST) readonly buffer BrickList { uint brick_list[]; };
 layout(binding = VEIL_IMAGE_EV, r32f) uniform image3D u_ev;
 
-// gb.dims.w: this dispatch's first layer of bricks (the splat is split to bound each dispatch's work)
+// gb.dims.w: this dispatch's first brick, in the order of the lists (x fastest, then y, then z): a
+// dispatch is a run of bricks, eight work groups each along x (the splat is split to bound each
+// dispatch's work)
 layout(std140, binding = VEIL_UBO_GRID) uniform veil_grid_ubo { veil_grid_block gb; };
 
 void main()
 {
-    ivec3 b = ivec3(gl_WorkGroupID) + ivec3(0, 0, gb.dims.w);
-    ivec3 v = b * VEIL_BRICK + ivec3(gl_LocalInvocationID);
+    const int first = gb.dims.w + int(gl_WorkGroupID.x) / 8, layer = gb.bricks.x * gb.bricks.y;
+    const int octant = int(gl_WorkGroupID.x) % 8;
+    ivec3 b = ivec3(first % gb.bricks.x, (first % layer) / gb.bricks.x, first / layer);
+    ivec3 v = b * VEIL_BRICK + HALF_BRICK * ivec3(octant & 1, (octant >> 1) & 1, octant >> 2) +
+              ivec3(gl_LocalInvocationID);
     if (any(greaterThanEqual(v, gb.dims.xyz))) return;
     uint brick = uint((b.z * gb.bricks.y + b.y) * gb.bricks.x + b.x);
     precise vec3 x = gb.origin.xyz + (vec3(v) + 0.5) * gb.origin.w;
