@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "../core/clock.h"
+#include "../core/progress.h"
 #include "../gpu/gl_util.h"
 #include "../gpu/programs.h"
 
@@ -129,6 +130,17 @@ static void fill_block(const veil_scene* sc, const veil_spread_input* in, int K,
     u->flags[2] = m->density_blur != 0, u->flags[3] = m->separation != 0;
 }
 
+/* After a pass of `passes`: with a progress sink, the pass finished and reported ("spread", passes done of
+ * all), and 1 when a cancel was asked for (issue 41: a pass of a 4K frame takes most of a second on a
+ * software rasteriser). */
+static int pass_done(int pass, int passes)
+{
+    if (!veil_progress_wanted()) return 0;
+    glFinish();
+    veil_progress("spread", pass, passes);
+    return pass < passes && veil_progress_cancelled();
+}
+
 veil_result veil_spread_run(veil_spread* s, const veil_scene* sc, const veil_spread_input* in, float* out,
                             float* level0, veil_spread_report* rep, veil_error* err)
 {
@@ -183,12 +195,13 @@ veil_result veil_spread_run(veil_spread* s, const veil_scene* sc, const veil_spr
         glBindImageTexture(VEIL_SPREAD_OUT_P, tex[P], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glBindImageTexture(VEIL_SPREAD_OUT_SSC, tex[SSC], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glDispatchCompute(veil_groups(pw, VEIL_SPREAD_GROUP), veil_groups(ph, VEIL_SPREAD_GROUP), 1);
+        int cancelled = pass_done(1, K + 2);
         /* 2: levels 1..K, each from the one below */
         glUseProgram(s->program[DOWN]);
         glBindTextureUnit(VEIL_SPREAD_TEX_SC, tex[SC]);
         glBindTextureUnit(VEIL_SPREAD_TEX_P, tex[P]);
         glBindTextureUnit(VEIL_SPREAD_TEX_SSC, tex[SSC]);
-        for (int k = 1; k <= K; ++k) {
+        for (int k = 1; k <= K && !cancelled; ++k) {
             glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
             u.mode[3] = k;
             glNamedBufferSubData(s->ubo, offsetof(veil_spread_block, mode), sizeof u.mode, u.mode);
@@ -196,18 +209,24 @@ veil_result veil_spread_run(veil_spread* s, const veil_scene* sc, const veil_spr
             glBindImageTexture(VEIL_SPREAD_OUT_P, tex[P], k, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
             glBindImageTexture(VEIL_SPREAD_OUT_SSC, tex[SSC], sep ? k : 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
             glDispatchCompute(veil_groups(pw >> k, VEIL_SPREAD_GROUP), veil_groups(ph >> k, VEIL_SPREAD_GROUP), 1);
+            cancelled = pass_done(1 + k, K + 2);
         }
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         /* 3: each pixel's level, read */
-        glUseProgram(s->program[FETCH]);
-        glBindImageTexture(VEIL_SPREAD_OUT, tex[OUT], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        glDispatchCompute(veil_groups(w, VEIL_SPREAD_GROUP), veil_groups(h, VEIL_SPREAD_GROUP), 1);
-        glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+        if (!cancelled) {
+            glUseProgram(s->program[FETCH]);
+            glBindImageTexture(VEIL_SPREAD_OUT, tex[OUT], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+            glDispatchCompute(veil_groups(w, VEIL_SPREAD_GROUP), veil_groups(h, VEIL_SPREAD_GROUP), 1);
+            glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+            pass_done(K + 2, K + 2);
+        }
         for (GLuint i = 0; i < 8; ++i) glBindImageTexture(i, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
         for (GLuint i = 0; i < 3; ++i) glBindTextureUnit(i, 0);
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_SPREAD, 0);
         glUseProgram(0);
         r = veil_gl_check("screen-space spread (render/shaders/spread_*.comp)", err);
+        if (r == VEIL_OK && cancelled)
+            r = veil_fail(err, VEIL_ERR_CANCELLED, "cancelled by the progress callback during the screen-space spread");
         if (r == VEIL_OK) r = veil_gl_read_texture(tex[OUT], GL_RGBA, floats, out, "reading back the spread", err);
         if (r == VEIL_OK && level0) r = read_level0(tex[SC], w, h, pw, ph, level0, err);
     }
