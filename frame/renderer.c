@@ -7,6 +7,7 @@
 #include "../core/clock.h"
 #include "../core/progress.h"
 #include "../propagate/opv_set.h"
+#include "../render/march.h"
 #include "../render/spread.h"
 #include "../volume/ev.h"
 #include "../volumetric/volumetric.h"
@@ -73,6 +74,12 @@ static veil_result make_gpu(veil_frame* f, veil_error* err)
     }
     f->plan.budget = r->memory_budget;
     f->plan.hardware = r->hardware;
+    if (!f->size_checked) { /* before any stage's GPU work: does the frame fit the device at all (issue 41)? */
+        f->size_checked = 1;
+        const veil_render_opts* o = &f->plan.o;
+        return veil_march_check_size(o->width, o->height, f->plan.scene->multiple.screen_space, r->hardware,
+                                     r->memory_budget, err);
+    }
     return VEIL_OK;
 }
 

@@ -209,6 +209,7 @@ typedef struct veil_frame {
     veil_result (*gpu)(struct veil_frame* f, veil_error* err);
     void* gpu_user;
     double gpu_ms; /* the time gpu() spent making the GPU's side: no stage's work, so no stage's time */
+    int size_checked; /* gpu() asked the device whether the frame's images fit (veil_march_check_size) */
     /* veil fog: the frame's surfaces as a solid (scene/solid.h) and its textures (voxels, shadow maps), made
      * by the first row that needs them and freed with the frame (veil_frame_end) */
     veil_solid solid;

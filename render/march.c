@@ -5,6 +5,7 @@
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <unistd.h>
 #include <string.h>
 
 #include "../core/clock.h"
@@ -195,6 +196,72 @@ static veil_result image(int w, int h, const char* label, GLuint* tex, veil_erro
     glTextureStorage2D(*tex, 1, GL_RGBA32F, w, h);
     glObjectLabel(GL_TEXTURE, *tex, -1, label);
     return veil_gl_check(label, err);
+}
+
+/* ---- the frame's size (veil_march_check_size) ---------------------------------------------------- */
+
+typedef struct size_need {
+    int driver;          /* 1: the driver holds an rgba32f texture of w x h (a proxy texture) */
+    double gpu, host;    /* bytes */
+} size_need;
+
+static size_need need_of(int w, int h, int spread)
+{
+    size_need n;
+    glTexImage2D(GL_PROXY_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, NULL);
+    GLint got = 0;
+    glGetTexLevelParameteriv(GL_PROXY_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &got);
+    n.driver = got == w;
+    const double px = (double)w * (double)h;
+    n.gpu = px * 16.0 * (spread ? VEIL_SPREAD_IMAGES : VEIL_MARCH_IMAGES); /* the spread's after the march's */
+    n.host = px * VEIL_IMAGE_HOST_BYTES;
+    return n;
+}
+
+static double physical_memory(void)
+{
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    return pages > 0 && page > 0 ? (double)pages * (double)page : 1e30;
+}
+
+static int fits(size_need n, int hardware, double gpu_budget, double host)
+{
+    return n.driver && n.gpu <= gpu_budget && n.host + (hardware ? 0.0 : n.gpu) <= host;
+}
+
+veil_result veil_march_check_size(int w, int h, int spread, int hardware, unsigned long long gpu_budget,
+                                  veil_error* err)
+{
+    const double host = physical_memory(), budget = gpu_budget ? (double)gpu_budget : 1e30;
+    const size_need n = need_of(w, h, spread);
+    glGetError(); /* a proxy that is refused sets no error; one the driver cannot even size may */
+    if (fits(n, hardware, budget, host)) return VEIL_OK;
+    /* the largest frame of this shape that fits: scale s in (0, 1), bisected on the proxy and the bytes */
+    double lo = 0.0, hi = 1.0;
+    for (int i = 0; i < 20; ++i) {
+        const double s = 0.5 * (lo + hi);
+        const int sw = (int)(w * s), sh = (int)(h * s);
+        if (sw >= 1 && sh >= 1 && fits(need_of(sw, sh, spread), hardware, budget, host)) lo = s;
+        else hi = s;
+    }
+    glGetError();
+    const int bw = (int)(w * lo), bh = (int)(h * lo);
+    char why[512];
+    if (!n.driver)
+        snprintf(why, sizeof why, "the GL driver (%s) holds no rgba32f texture of %dx%d (%.3g GB; a proxy texture "
+                 "says so)", (const char*)glGetString(GL_RENDERER), w, h, (double)w * h * 16.0 / 1e9);
+    else if (n.gpu > budget)
+        snprintf(why, sizeof why, "its %d rgba32f textures take %.3g GB, over the %.3g GB veil allows itself on this "
+                 "device (veil_gl_info's memory budget)", spread ? VEIL_SPREAD_IMAGES : VEIL_MARCH_IMAGES, n.gpu / 1e9,
+                 budget / 1e9);
+    else
+        snprintf(why, sizeof why, "its buffers take %.3g GB of memory%s, over the machine's %.3g GB", n.host / 1e9,
+                 hardware ? "" : " (the textures' included: a software rasteriser's live there)",
+                 host / 1e9);
+    if (bw >= 1 && bh >= 1)
+        return veil_fail(err, VEIL_ERR_LIMIT, "a %dx%d image: %s; the largest image of this shape this device "
+                         "renders is %dx%d", w, h, why, bw, bh);
+    return veil_fail(err, VEIL_ERR_LIMIT, "a %dx%d image: %s", w, h, why);
 }
 
 static uint64_t g_band_work = 0, g_light_list_work = VEIL_MARCH_LIGHT_LIST_WORK; /* g_band_work 0: the desc's */

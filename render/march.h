@@ -104,6 +104,24 @@ veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* ou
 /* Marches every pixel and reads the image set back (*out: freed first). */
 veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_set* out, veil_error* err);
 
+/* Whether a w x h frame fits this device and this machine (issue 41: a
+ * 16384^2 frame, within the documented limits, failed after the volume was
+ * made with "GL_OUT_OF_MEMORY"): asked before any GPU work, of GL and of
+ * the memory. The march makes VEIL_MARCH_IMAGES rgba32f textures of w x h
+ * and the screen-space spread (spread: 1 when it may run) up to
+ * VEIL_SPREAD_IMAGES' worth, each first asked of the driver as a proxy
+ * texture (llvmpipe holds at most 1 GiB in one: 8192^2 rgba32f); the
+ * textures' bytes within gpu_budget (veil_gl_info's memory_budget); the
+ * image set and its EXR's planes (VEIL_IMAGE_HOST_BYTES a pixel), and on a
+ * software rasteriser the textures too, within the machine's physical
+ * memory. VEIL_ERR_LIMIT naming what does not fit, with the largest frame
+ * of the same shape that does. Needs a current GL context. */
+#define VEIL_MARCH_IMAGES 5
+#define VEIL_SPREAD_IMAGES 9 /* 4 inputs, the output, 3 chains of 4/3 of a level */
+#define VEIL_IMAGE_HOST_BYTES 192
+veil_result veil_march_check_size(int w, int h, int spread, int hardware, unsigned long long gpu_budget,
+                                  veil_error* err);
+
 /* The rows of a band for d at w x h (a multiple of VEIL_MARCH_GROUP, or h). */
 int veil_march_band_rows(const veil_march_desc* d, int w, int h);
 

@@ -86,4 +86,18 @@ cat "$tmp/stats.txt"
 grep -q "demo.exr: 96x72, " "$tmp/stats.txt" || fail "EXR size: $(cat "$tmp/stats.txt")"
 "$stats" --png "$tmp/demo.png" 96 72 > "$tmp/png.txt" 2>&1 || fail "PNG: $(cat "$tmp/png.txt")"
 ls "$tmp" | grep -q tmp && fail "temporary file left behind: $(ls "$tmp")"
+
+# The largest size the options allow (issue 41, item 8): a device that cannot hold it refuses it before any
+# GPU work (exit 1, the largest image of the shape it can render named, nothing written); one that can
+# (a GPU of tens of GB) renders it. Before: GL_OUT_OF_MEMORY, exit 3, after the volume was made.
+"$veil" render "$scene" -o "$tmp/huge.exr" --width 16384 --height 16384 > "$tmp/huge.txt" 2>&1
+rc=$?
+if [ $rc -eq 1 ]; then
+  grep -q "a 16384x16384 image: .*; the largest image of this shape this device renders is [0-9]*x[0-9]*" "$tmp/huge.txt" ||
+    fail "16384x16384 refused without the largest size: $(cat "$tmp/huge.txt")"
+  [ -e "$tmp/huge.exr" ] && fail "a refused 16384x16384 render wrote its EXR"
+else
+  [ $rc -eq 0 ] || fail "16384x16384: exit $rc: $(cat "$tmp/huge.txt")"
+fi
+rm -f "$tmp/huge.exr"
 echo "PASS"
