@@ -19,6 +19,7 @@
 #include "vdb.h"
 #include "vdb_header.hpp"
 #include "../core/text.h"
+#include "../scene/limits.h"
 extern "C" {
 #include "../core/progress.h"
 }
@@ -150,6 +151,14 @@ private:
 std::string quoted(const std::string& s) { return "'" + s + "'"; }
 // (for a non-const string, which std::quoted, found by ADL, would otherwise take)
 std::string quoted(std::string& s) { return "'" + s + "'"; }
+
+// A number for a message: "1.2e+31" rather than std::to_string's 32 digits.
+std::string number_text(double v)
+{
+    char b[32];
+    std::snprintf(b, sizeof b, "%.3g", v);
+    return b;
+}
 
 // Runs f, mapping every exception to a result: `what` prefixes the messages
 // of exceptions thrown by OpenVDB or the standard library (normally the file).
@@ -535,6 +544,25 @@ void place(GridBase& grid, const double m[4][4], const char* label)
     if (!(std::fabs(det) > 1e-12 * scale * scale * scale))
         fail_with(VEIL_ERR_INVALID, std::string(label) + ": the index-to-world matrix is singular (determinant " +
                                         std::to_string(det) + "): a voxel would have no volume");
+    if (!(std::fabs(det) >= VEIL_MIN_VOXEL_VOLUME)) // OpenVDB's AffineMap would throw "nearly singular"
+        fail_with(VEIL_ERR_INVALID, std::string(label) + ": the index-to-world matrix makes a voxel of " +
+                                        number_text(std::fabs(det)) + " m^3, under the " +
+                                        number_text(VEIL_MIN_VOXEL_VOLUME) +
+                                        " m^3 (a cube of 14.4 um) OpenVDB's maps hold (scene/limits.h)");
+    double far = 0.0, edge = HUGE_VAL;
+    for (int c = 0; c < 3; ++c) edge = std::min(edge, std::sqrt(m[0][c] * m[0][c] + m[1][c] * m[1][c] + m[2][c] * m[2][c]));
+    for (int r = 0; r < 3; ++r) { // index (0, 0, 0) within the scene's coordinates
+        if (!(std::fabs(m[r][3]) <= VEIL_MAX_COORD))
+            fail_with(VEIL_ERR_INVALID, std::string(label) + ": the index-to-world matrix puts index (0, 0, 0) at " +
+                                            "xyz"[r] + std::string(" = ") + number_text(m[r][3]) +
+                                            " m, beyond the scene's +-1e15 m (scene/limits.h)");
+        far = std::max(far, std::fabs(m[r][3]));
+    }
+    if (!(edge >= VEIL_MIN_VOXEL_RELATIVE * far)) // single-precision positions past here: VEIL_MIN_VOXEL_RELATIVE
+        fail_with(VEIL_ERR_INVALID, std::string(label) + ": the index-to-world matrix makes voxels of " +
+                                        number_text(edge) + " m at " + number_text(far) +
+                                        " m from the origin, under 2^-16 of that distance: finer than "
+                                        "single-precision positions resolve there (scene/limits.h)");
     grid.setTransform(openvdb::math::Transform::createLinearTransform(a));
 }
 
@@ -726,14 +754,6 @@ FloatGrid::Ptr grown_topology(const FloatGrid& g, int reach)
         out->tree().sparseFill(b, 0.0f, true);
     }
     return out;
-}
-
-// A number for a message: "1.2e+31" rather than std::to_string's 32 digits.
-std::string number_text(double v)
-{
-    char b[32];
-    std::snprintf(b, sizeof b, "%.3g", v);
-    return b;
 }
 
 // Floor of c / b for a power of two b (and negative c).

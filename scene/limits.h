@@ -88,6 +88,19 @@
 #define VEIL_LIMITS_H
 
 #define VEIL_MAX_COORD 1e15
+/* A grid's voxel, the |determinant| of its index-to-world map (m^3), is at
+ * least this (issue 41): OpenVDB's affine maps refuse a smaller one as
+ * nearly singular (3 x its double tolerance of 1e-15; a cube of 14.4 um a
+ * side), so a grid from memory or a VDB source's "transform" below it is
+ * refused by name instead of failing in OpenVDB. */
+#define VEIL_MIN_VOXEL_VOLUME 3e-15
+/* And its smallest edge at least this fraction of the largest |coordinate|
+ * of the grid's box: positions are single precision past the reader (the
+ * volume's grid, the shaders), 2^-24 of their size apart, so a voxel spans
+ * at least 2^8 of those steps (the 8 bits a GPU's trilinear weights have).
+ * A 1e-4 m voxel at 9e14 m made a grid of no width (OpenVDB: "Non-zero
+ * scale values required"). */
+#define VEIL_MIN_VOXEL_RELATIVE 0x1p-16
 #define VEIL_MIN_SHARPNESS 1e-29
 #define VEIL_MAX_LIGHT 1e20
 #define VEIL_MAX_SIGMA 1e10

@@ -9,6 +9,7 @@
 
 #include "../core/hash.h"
 #include "frame_pattern.h"
+#include "limits.h"
 
 /* At most this many values in a grid from memory (as VEIL_VDB_MAX_DENSE_VOXELS: 2^30 floats, 4 GiB). */
 #define VEIL_SCENE_GRID_MAX_VALUES ((size_t)1 << 30)
@@ -57,6 +58,27 @@ veil_result veil_scene_grid_set(veil_scene* s, const char* name, const float* da
                          "(an affine map)", name, m[3][0], m[3][1], m[3][2], m[3][3]);
     if (affine == 0)
         return veil_fail(err, VEIL_ERR_INVALID, "grid '%.200s': index_to_world is singular (determinant %g)", name, det);
+    if (!(fabs(det) >= VEIL_MIN_VOXEL_VOLUME))
+        return veil_fail(err, VEIL_ERR_INVALID, "grid '%.200s': index_to_world makes a voxel of %g m^3, under the "
+                         "%g m^3 (a cube of 14.4 um) OpenVDB's maps hold (scene/limits.h)", name, fabs(det),
+                         VEIL_MIN_VOXEL_VOLUME);
+    double far = 0.0, edge = INFINITY; /* the largest |coordinate| of the box; the smallest voxel edge */
+    for (int c = 0; c < 3; ++c) edge = fmin(edge, sqrt(m[0][c] * m[0][c] + m[1][c] * m[1][c] + m[2][c] * m[2][c]));
+    for (int corner = 0; corner < 8; ++corner) { /* the grid's box within the scene's coordinates */
+        const double idx[3] = {corner & 1 ? dims[0] - 1 : 0, corner & 2 ? dims[1] - 1 : 0, corner & 4 ? dims[2] - 1 : 0};
+        for (int r = 0; r < 3; ++r) {
+            const double x = m[r][0] * idx[0] + m[r][1] * idx[1] + m[r][2] * idx[2] + m[r][3];
+            if (!(fabs(x) <= VEIL_MAX_COORD))
+                return veil_fail(err, VEIL_ERR_INVALID, "grid '%.200s': index_to_world puts index [%.0f, %.0f, %.0f] "
+                                 "at %c = %g m, beyond the scene's +-%g m (scene/limits.h)", name, idx[0], idx[1],
+                                 idx[2], "xyz"[r], x, VEIL_MAX_COORD);
+            far = fmax(far, fabs(x));
+        }
+    }
+    if (!(edge >= VEIL_MIN_VOXEL_RELATIVE * far))
+        return veil_fail(err, VEIL_ERR_INVALID, "grid '%.200s': voxels of %g m at %g m from the origin, under 2^-16 of "
+                         "that distance (%g m): finer than single-precision positions resolve there (scene/limits.h)",
+                         name, edge, far, VEIL_MIN_VOXEL_RELATIVE * far);
     /* a value that is not finite, refused here: OpenVDB's copyFromDense would take a NaN for the
      * background (its comparison with 0 is false) and the grid would read 0 there, silently */
     size_t bad = 0, first = 0;

@@ -15,7 +15,13 @@
  *    back, reports while the map is decoded and while it is cut; a cancel
  *    asked for at the first report of either ends the read there
  *    (VEIL_ERR_CANCELLED, no report after, no scene); a bad description is
- *    refused naming the field.
+ *    refused naming the field;
+ *  - item 5: the screen-space spread (the last long loop a render runs)
+ *    honours a cancel asked for after its first pass (VEIL_ERR_CANCELLED
+ *    naming it), and its reports go 0 .. 1;
+ *  - item 9: veil_scene_set_grid refuses voxels under VEIL_MIN_VOXEL_VOLUME
+ *    (OpenVDB's floor) or finer than single precision resolves where they
+ *    are, and a box beyond VEIL_MAX_COORD, naming the grid (scene/limits.h).
  * Exit 77 (skipped) when no GL context can be made, except under CI=true. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -228,6 +234,42 @@ static void spread_cancel(veil_context* ctx)
     veil_scene_close(s);
 }
 
+/* ---- item 9 ---------------------------------------------------------------- */
+
+/* Grids from memory placed where veil cannot hold them: refused by veil_scene_set_grid naming the grid and
+ * the bound (before: accepted, then the render failed with VEIL_ERR_IO "cannot read the OpenVDB file" for a
+ * grid that never was one, or rendered a grid of no width). */
+static void grids_out_of_reach(void)
+{
+    veil_error err = {{0}};
+    veil_scene* s = NULL;
+    CHECK(veil_scene_from_json(SCENE, NULL, "grids", &s, &err) == VEIL_OK, "%s", err.msg);
+    if (!s) return;
+    static float values[8 * 8 * 8];
+    for (int i = 0; i < 512; ++i) values[i] = 1.0f;
+    struct {
+        double scale, shift;
+        veil_result want;
+        const char* says;
+    } cases[] = {{1e-6, 0.0, VEIL_ERR_INVALID, "m^3 (a cube of 14.4 um) OpenVDB's maps hold"},
+                 {1.4e-5, 0.0, VEIL_ERR_INVALID, "m^3 (a cube of 14.4 um) OpenVDB's maps hold"},
+                 {1.5e-5, 0.0, VEIL_OK, ""},
+                 {0.1, 2e15, VEIL_ERR_INVALID, "beyond the scene's +-1e+15 m"},
+                 {0.1, 9e14, VEIL_ERR_INVALID, "finer than single-precision positions resolve there"},
+                 {1e11, 9e14, VEIL_OK, ""}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        veil_grid_desc g = VEIL_GRID_DESC_INIT;
+        g.data = values, g.dims[0] = g.dims[1] = g.dims[2] = 8;
+        g.index_to_world[0] = g.index_to_world[5] = g.index_to_world[10] = cases[i].scale;
+        g.index_to_world[3] = cases[i].shift, g.index_to_world[15] = 1.0;
+        err.msg[0] = '\0';
+        veil_result r = veil_scene_set_grid(s, "density", &g, &err);
+        CHECK(r == cases[i].want && (r == VEIL_OK || (strstr(err.msg, "grid 'density'") && strstr(err.msg, cases[i].says))),
+              "voxel %g m at %g m: %s: %s", cases[i].scale, cases[i].shift, veil_result_name(r), err.msg);
+    }
+    veil_scene_close(s);
+}
+
 /* ---- item 3 ---------------------------------------------------------------- */
 
 typedef enum hostile_act {
@@ -372,6 +414,7 @@ int main(int argc, char** argv)
     if (test_dir_begin("api_hostile")) {
         scene_read_cancel(argv[1]);
         spread_cancel(ctx);
+        grids_out_of_reach();
         writers_spare_inputs(ctx);
         callbacks_touching_contexts();
         CHECK(test_dir_end(), "temporary folder left clean");
