@@ -561,7 +561,7 @@ void place(GridBase& grid, const double m[4][4], const char* label)
     if (!(edge >= VEIL_MIN_VOXEL_RELATIVE * far)) // single-precision positions past here: VEIL_MIN_VOXEL_RELATIVE
         fail_with(VEIL_ERR_INVALID, std::string(label) + ": the index-to-world matrix makes voxels of " +
                                         number_text(edge) + " m at " + number_text(far) +
-                                        " m from the origin, under 2^-16 of that distance: finer than "
+                                        " m from the origin, under 2^-20 of that distance: finer than "
                                         "single-precision positions resolve there (scene/limits.h)");
     grid.setTransform(openvdb::math::Transform::createLinearTransform(a));
 }

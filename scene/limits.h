@@ -96,11 +96,11 @@
 #define VEIL_MIN_VOXEL_VOLUME 3e-15
 /* And its smallest edge at least this fraction of the largest |coordinate|
  * of the grid's box: positions are single precision past the reader (the
- * volume's grid, the shaders), 2^-24 of their size apart, so a voxel spans
- * at least 2^8 of those steps (the 8 bits a GPU's trilinear weights have).
- * A 1e-4 m voxel at 9e14 m made a grid of no width (OpenVDB: "Non-zero
- * scale values required"). */
-#define VEIL_MIN_VOXEL_RELATIVE 0x1p-16
+ * volume's grid, the shaders), 2^-24 of their size apart at worst, so a
+ * voxel spans at least 16 of those steps (a sample's place in its voxel
+ * known to 1/16 at worst). A 1e-4 m voxel at 9e14 m made a grid of no width
+ * (OpenVDB: "Non-zero scale values required"). */
+#define VEIL_MIN_VOXEL_RELATIVE 0x1p-20
 #define VEIL_MIN_SHARPNESS 1e-29
 #define VEIL_MAX_LIGHT 1e20
 #define VEIL_MAX_SIGMA 1e10

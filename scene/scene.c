@@ -13,6 +13,10 @@
 
 /* At most this many values in a grid from memory (as VEIL_VDB_MAX_DENSE_VOXELS: 2^30 floats, 4 GiB). */
 #define VEIL_SCENE_GRID_MAX_VALUES ((size_t)1 << 30)
+/* A grid is held as OpenVDB's tree of 8^3 leaves (io/vdb.h): a thin one pads every value to a leaf (a 1 x 1
+ * x 2^28 line takes 2^25 leaves of 512 values: 64 GiB and 74 s where a cube of as many values takes 1 GiB and
+ * 1.8 s). The leaves' voxels, at most twice the values' cap (8 GiB), refused from the dimensions alone. */
+#define VEIL_SCENE_GRID_MAX_TREE_VOXELS ((double)((size_t)1 << 31))
 
 int veil_affine_check(const double m[4][4], double* det)
 {
@@ -45,6 +49,13 @@ veil_result veil_scene_grid_set(veil_scene* s, const char* name, const float* da
             return veil_fail(err, VEIL_ERR_LIMIT, "grid '%.200s': %dx%dx%d values, over the limit of 2^30", name,
                              dims[0], dims[1], dims[2]);
     }
+    double leaves = 1.0;
+    for (int a = 0; a < 3; ++a) leaves *= (double)((dims[a] + 7) / 8);
+    if (leaves * 512.0 > VEIL_SCENE_GRID_MAX_TREE_VOXELS)
+        return veil_fail(err, VEIL_ERR_LIMIT, "grid '%.200s': %dx%dx%d values fill %.0f of OpenVDB's 8^3 leaves, "
+                         "%.3g voxels (%.3g GB) as veil holds a grid, over the limit of 2^31 (8.6 GB): a grid this "
+                         "thin pads each value to a leaf; give it at least 8 voxels thick, or fewer values", name,
+                         dims[0], dims[1], dims[2], leaves, leaves * 512.0, leaves * 512.0 * 4.0 / 1e9);
     const double(*m)[4] = index_to_world;
     for (int r = 0; r < 4; ++r)
         for (int c = 0; c < 4; ++c)
@@ -76,7 +87,7 @@ veil_result veil_scene_grid_set(veil_scene* s, const char* name, const float* da
         }
     }
     if (!(edge >= VEIL_MIN_VOXEL_RELATIVE * far))
-        return veil_fail(err, VEIL_ERR_INVALID, "grid '%.200s': voxels of %g m at %g m from the origin, under 2^-16 of "
+        return veil_fail(err, VEIL_ERR_INVALID, "grid '%.200s': voxels of %g m at %g m from the origin, under 2^-20 of "
                          "that distance (%g m): finer than single-precision positions resolve there (scene/limits.h)",
                          name, edge, far, VEIL_MIN_VOXEL_RELATIVE * far);
     /* a value that is not finite, refused here: OpenVDB's copyFromDense would take a NaN for the

@@ -1,5 +1,6 @@
 """veil.Context, veil.render and veil.turntable."""
 
+import collections.abc
 import ctypes
 import os
 import re
@@ -349,6 +350,25 @@ def _check_not_scene(output, scene_file):
                         "would be overwritten" % (os.fsdecode(os.fspath(output)), os.fsdecode(os.fspath(scene_file))))
 
 
+def _check_arguments(grids, context):
+    """TypeError for a grids or context argument of the wrong kind (before: AttributeError from deep inside)."""
+    if grids is not None and not isinstance(grids, collections.abc.Mapping):
+        raise TypeError("grids: expected a dict {name: array, or (array, index_to_world)}, got %s"
+                        % type(grids).__name__)
+    if context is not None and not isinstance(context, Context):
+        raise TypeError("context: expected a veil.Context, got %s" % type(context).__name__)
+
+
+def _output_path(output):
+    """output= as a str path (a bytes or os.PathLike one decoded as the file system does), or None."""
+    if output is None:
+        return None
+    try:
+        return os.fsdecode(os.fspath(output))
+    except TypeError:
+        raise TypeError("output: expected a path (str, bytes or os.PathLike), got %s" % type(output).__name__) from None
+
+
 def _check_output(output):
     if output is None:
         return
@@ -463,6 +483,8 @@ def render(scene, grids=None, quality=None, size=None, seed=0, step_voxels=None,
     Raises veil.VeilError (.code, .name, .message: the file and JSON field),
     veil.Cancelled when cancelled, TypeError/ValueError for bad arguments.
     """
+    _check_arguments(grids, context)
+    output = _output_path(output)
     if context is not None:
         context._use()
     width, height = _size(size)
@@ -505,6 +527,8 @@ def turntable(scene, frames, grids=None, quality=None, size=None, seed=0, step_v
     other argument and the dicts are as veil.render's. A generator: frames
     render as they are asked for; closing it early releases the scene.
     """
+    _check_arguments(grids, context)
+    output = _output_path(output)
     frames = _number("frames", frames, 1, 2**31 - 1, integer=True)
     start = _number("start", start, 0, frames - 1, integer=True)
     stop = frames if stop is None else _number("stop", stop, start, frames, integer=True)

@@ -1,6 +1,8 @@
 """Grids from memory: a numpy array as an "array" source against the same values written with
 pyopenvdb and read from the file, the axis order both ways, the transforms, the dtypes."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -138,6 +140,47 @@ def test_bad_shapes_are_refused(shape):
 def test_bad_index_to_world_is_refused(matrix, match):
     with pytest.raises(ValueError, match=match):
         veil.render(scene(ARRAY), grids={"density": (np.ones((4, 4, 4), np.float32), matrix)})
+
+
+def test_arguments_of_the_wrong_kind_are_type_errors(tmp_path):
+    """Issue 41, item 11: grids=[array] and context="x" raised AttributeError from deep inside; now TypeError
+    naming the argument. A bytes output path was 'expected a .exr or .png file name'; now it is a path."""
+    with pytest.raises(TypeError, match="grids: expected a dict"):
+        veil.render(scene(ARRAY), grids=[sphere(8)])
+    with pytest.raises(TypeError, match="context: expected a veil.Context, got str"):
+        veil.render(scene(ARRAY), grids={"density": sphere(8)}, context="x")
+    with pytest.raises(TypeError, match="grids: expected a dict"):
+        next(veil.turntable(scene(ARRAY), 2, grids=[sphere(8)]))
+    with pytest.raises(TypeError, match="output: expected a path"):
+        veil.render(scene(ARRAY), grids={"density": sphere(8)}, output=3)
+
+
+def test_bytes_output_path(gl, grids_api, tmp_path):
+    out = veil.render(scene(ARRAY), grids={"density": sphere(8)}, output=os.fsencode(tmp_path / "b.exr"))
+    assert out.path == str(tmp_path / "b.exr") and (tmp_path / "b.exr").stat().st_size > 0
+
+
+def test_thin_grid_over_the_tree_limit_is_refused_at_once(grids_api):
+    """Issue 41, item 11: a (1, 1, 2^28) array padded each value to an 8^3 leaf of OpenVDB's tree: 74 s and
+    64 GiB to inject where a cube of as many values takes 1.8 s. Refused from its dimensions, before a value
+    is read (np.zeros is not even touched), naming the grid and the numbers."""
+    line = np.zeros((1, 1, 2**28), np.float32)
+    with pytest.raises(veil.VeilError) as e:
+        veil.render(scene(ARRAY), grids={"density": line})
+    assert e.value.name == "VEIL_ERR_LIMIT" and "'density': 1x1x268435456 values" in e.value.message, e.value.message
+    assert "8^3 leaves" in e.value.message
+
+
+def test_grid_placed_beyond_what_veil_holds_is_refused(grids_api):
+    """Issue 41, item 9: voxels under OpenVDB's floor, or finer than single precision where they lie, or a box
+    beyond +-1e15 m: VEIL_ERR_INVALID naming the grid at veil_scene_set_grid (before: VEIL_ERR_IO 'cannot read
+    the OpenVDB file' at the render, for a grid that never was a file)."""
+    for m, says in ((np.diag([1e-6, 1e-6, 1e-6, 1.0]), "OpenVDB's maps hold"),
+                    (np.array([[0.1, 0, 0, 2e15], [0, 0.1, 0, 0], [0, 0, 0.1, 0], [0, 0, 0, 1]]), "beyond the scene's"),
+                    (np.array([[0.1, 0, 0, 9e14], [0, 0.1, 0, 0], [0, 0, 0.1, 0], [0, 0, 0, 1]]), "single-precision")):
+        with pytest.raises(veil.VeilError) as e:
+            veil.render(scene(ARRAY), grids={"density": (sphere(8), m)})
+        assert e.value.name == "VEIL_ERR_INVALID" and "'density'" in e.value.message and says in e.value.message
 
 
 def test_layouts_are_passed_without_a_copy():
