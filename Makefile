@@ -16,7 +16,8 @@
 #               build/regress/), stage by stage and whole process, in turn on a fixed set of scenes
 #               (bench/regress.py; REGRESS_ARGS="--runs 7 --scenes demo,cloud"): a benchmark, not a test
 #   make fuzz   libFuzzer on the scene parser, the particle readers, the EXR and
-#               the OpenVDB readers, frame patterns and a run's files, FUZZ_SECONDS each (default 60), under ASan and
+#               the OpenVDB readers, frame patterns and a run's files, environment maps, velocities,
+#               grids from memory and scenes with them, FUZZ_SECONDS each (default 60), under ASan and
 #               UBSan, in build-fuzz/ (scripts/fuzz.sh)
 #   make test-sanitize  every test built with AddressSanitizer and UndefinedBehaviorSanitizer
 #                  (undefined behaviour fatal) in build-sanitize/; leaks in Mesa and LLVM
@@ -103,8 +104,9 @@ fuzz:
 	@bash scripts/install-bench-deps.sh clang
 	@CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVEIL_FUZZ=ON \
 	  -DVEIL_SANITIZE=ON >/dev/null
-	@cmake --build build-fuzz -j $(JOBS) --target fuzz_scene fuzz_particles fuzz_exr fuzz_vdb fuzz_nanovdb fuzz_paths make_test_vdbs \
-	  make_compare_exrs veil_cli -- --no-print-directory
+	@cmake --build build-fuzz -j $(JOBS) --target fuzz_scene fuzz_particles fuzz_exr fuzz_vdb fuzz_nanovdb fuzz_paths \
+	  fuzz_envmap fuzz_velocity fuzz_grid fuzz_arrays make_test_vdbs make_compare_exrs make_env_map veil_cli \
+	  -- --no-print-directory
 	@bash scripts/fuzz.sh build-fuzz $(FUZZ_SECONDS)
 
 clean:

@@ -20,7 +20,7 @@ build=$1
 seconds=${2:-60}
 root=$(cd "$(dirname "$0")/.." && pwd)
 seeds=$build/fuzz-seeds
-mkdir -p "$seeds"/{vdb,nanovdb,exr,particles} "$build/crashes"
+mkdir -p "$seeds"/{vdb,nanovdb,exr,particles,envmap,velocity} "$build/crashes"
 "$build/tests/make_test_vdbs" "$seeds/vdb.tmp" >/dev/null || exit 1
 for f in offset_scaled.vdb offset_scaled.nvdb offset_scaled_half.vdb two_grids.vdb emissive_slab.vdb empty.vdb \
     chunk_big.vdb chunk_raw.vdb chunk_header.vdb root_count.vdb no_offsets.vdb half_mismatch.vdb; do
@@ -29,8 +29,17 @@ done
 for f in offset_scaled.nvdb nano_size.nvdb nano_child.nvdb; do
     cp "$seeds/vdb.tmp/$f" "$seeds/nanovdb/" 2>/dev/null
 done
+# velocities: a vec3 grid, a vec3d one and a float triple (blur.vdb), a sequence's file, a file with none
+for f in blur.vdb moving.0001.vdb two_grids.vdb; do
+    cp "$seeds/vdb.tmp/$f" "$seeds/velocity/" 2>/dev/null
+done
 rm -rf "$seeds/vdb.tmp"
 "$build/tests/make_compare_exrs" "$seeds/exr" >/dev/null || exit 1
+# environment maps: 2:1 maps of a few sizes (the corpus has one over the texel limit, by its header)
+for size in "8 4" "64 32" "256 128"; do
+    # shellcheck disable=SC2086
+    "$build/tests/make_env_map" "$seeds/envmap/sky_${size// /x}.exr" $size || exit 1
+done
 # particle files in both formats, as veil writes them
 for format in binary json; do
     "$build/veil" rbf generate -o "$seeds/particles/three.$format" --count 3 --seed 1 --bounds 0,0,0,1,1,1 \
@@ -39,7 +48,7 @@ done
 fails=0
 export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 export LSAN_OPTIONS=suppressions=$root/tests/support/lsan.supp:print_suppressions=0
-for t in scene particles exr vdb nanovdb paths; do
+for t in scene particles exr vdb nanovdb paths envmap velocity grid arrays; do
     mkdir -p "$build/corpus/$t"
     dirs=("$build/corpus/$t")
     [ -d "$root/tests/fuzz/corpus/$t" ] && dirs+=("$root/tests/fuzz/corpus/$t")

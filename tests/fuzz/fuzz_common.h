@@ -11,7 +11,7 @@
 #include <unistd.h>
 
 /* The input written to a file named `name` in a folder made once; returns its path. */
-static const char* fuzz_file(const uint8_t* data, size_t size, const char* name)
+static inline const char* fuzz_file(const uint8_t* data, size_t size, const char* name)
 {
     static char dir[64], path[128];
     if (!dir[0]) {
