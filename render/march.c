@@ -224,6 +224,12 @@ static double physical_memory(void)
     return pages > 0 && page > 0 ? (double)pages * (double)page : 1e30;
 }
 
+static void clear_gl_errors(void)
+{
+    for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) {
+    }
+}
+
 static int fits(size_need n, int hardware, double gpu_budget, double host)
 {
     return n.driver && n.gpu <= gpu_budget && n.host + (hardware ? 0.0 : n.gpu) <= host;
@@ -234,7 +240,7 @@ veil_result veil_march_check_size(int w, int h, int spread, int hardware, unsign
 {
     const double host = physical_memory(), budget = gpu_budget ? (double)gpu_budget : 1e30;
     const size_need n = need_of(w, h, spread);
-    glGetError(); /* a proxy that is refused sets no error; one the driver cannot even size may */
+    clear_gl_errors(); /* a proxy that is refused sets no error; one over GL_MAX_TEXTURE_SIZE may */
     if (fits(n, hardware, budget, host)) return VEIL_OK;
     /* the largest frame of this shape that fits: scale s in (0, 1), bisected on the proxy and the bytes */
     double lo = 0.0, hi = 1.0;
@@ -244,7 +250,7 @@ veil_result veil_march_check_size(int w, int h, int spread, int hardware, unsign
         if (sw >= 1 && sh >= 1 && fits(need_of(sw, sh, spread), hardware, budget, host)) lo = s;
         else hi = s;
     }
-    glGetError();
+    clear_gl_errors();
     const int bw = (int)(w * lo), bh = (int)(h * lo);
     char why[512];
     if (!n.driver)
