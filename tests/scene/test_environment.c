@@ -362,7 +362,7 @@ static void write_map(const char* name, int w, int h, float value, float bad)
         p[c] = malloc((size_t)w * h * sizeof(float));
         for (int i = 0; i < w * h; ++i) p[c][i] = value;
     }
-    p[1][w + 2] = bad; /* texel (2, 1), G */
+    if (w > 2 && h > 1) p[1][w + 2] = bad; /* texel (2, 1), G (a map too small to have it has none) */
     const char* names[3] = {"R", "G", "B"};
     veil_error e = {0};
     CHECK(veil_write_exr_planes(path, w, h, 3, names, (const float* const*)p, &e) == VEIL_OK, "%s", e.msg);
