@@ -533,7 +533,8 @@ static veil_result render_build(veil_frame* f, veil_stage_report* rep, veil_erro
                           .max_distance = o->max_distance, .end_distance = o->behind_distance,
                           .no_background = o->behind != NULL, .field = &f->field,
                           .deep_raw = o->deep ? veil_deep_raw_samples(o->deep_samples) : 0,
-                          .band_work = p->hardware ? VEIL_MARCH_DISPATCH_WORK : VEIL_MARCH_SOFTWARE_WORK};
+                          .band_work = p->hardware ? VEIL_MARCH_DISPATCH_WORK : VEIL_MARCH_SOFTWARE_WORK,
+                          .band_seconds = p->hardware ? 0.0 : VEIL_MARCH_BAND_SECONDS};
     md.medium.opv = opv;
     /* the cache's later light gathered towards the camera: as the scene says, else the rung's where the
      * phase function's forward peak holds at least half its scattering (render/march.h) */

@@ -402,7 +402,12 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
     const int light_list = row_work(d, w) * h >= (double)g_light_list_work;
     if (r == VEIL_OK) r = program_for(m, lm, &mu, &u, light_list, d->deep_raw, &program, err);
     /* deep: a band's buffers (counts, R samples a pixel) within VEIL_DEEP_BAND_BYTES, read after each band */
-    int band = veil_march_band_rows(d, w, h);
+    /* bands: without a progress sink no cancel can come and a dispatch's own bound serves; with one, the
+     * desc's (a software rasteriser's shorter bands), sized anew after each to take band_seconds */
+    const int report = veil_progress_wanted(), adapt = report && d->band_seconds > 0.0 && !g_band_work;
+    veil_march_desc bands = *d;
+    if (!report) bands.band_work = VEIL_MARCH_DISPATCH_WORK;
+    int band = veil_march_band_rows(&bands, w, h), band_cap = h;
     GLuint deep_buf[2] = {0, 0};
     uint32_t* deep_counts = NULL;
     float* deep_samples = NULL;
@@ -412,15 +417,16 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         size_t rows = VEIL_DEEP_BAND_BYTES / row_bytes / VEIL_MARCH_GROUP * VEIL_MARCH_GROUP;
         if (rows < VEIL_MARCH_GROUP) rows = VEIL_MARCH_GROUP;
         if ((size_t)band > rows) band = (int)rows;
+        if ((size_t)band_cap > rows) band_cap = (int)rows;
         out->deep.width = w, out->deep.height = h;
-        deep_counts = malloc((size_t)band * (size_t)w * sizeof *deep_counts);
-        deep_samples = malloc((size_t)band * deep_row_floats * sizeof *deep_samples);
+        deep_counts = malloc((size_t)band_cap * (size_t)w * sizeof *deep_counts);
+        deep_samples = malloc((size_t)band_cap * deep_row_floats * sizeof *deep_samples);
         if (!deep_counts || !deep_samples) r = veil_fail(err, VEIL_ERR_OOM, "out of memory for a band of deep samples");
         if (r == VEIL_OK)
-            r = veil_gl_buffer(NULL, (size_t)band * (size_t)w * sizeof(uint32_t), GL_DYNAMIC_STORAGE_BIT,
+            r = veil_gl_buffer(NULL, (size_t)band_cap * (size_t)w * sizeof(uint32_t), GL_DYNAMIC_STORAGE_BIT,
                                "veil deep counts", &deep_buf[0], err);
         if (r == VEIL_OK)
-            r = veil_gl_buffer(NULL, (size_t)band * deep_row_floats * sizeof(float), GL_DYNAMIC_STORAGE_BIT,
+            r = veil_gl_buffer(NULL, (size_t)band_cap * deep_row_floats * sizeof(float), GL_DYNAMIC_STORAGE_BIT,
                                "veil deep samples", &deep_buf[1], err);
     }
     if (r == VEIL_OK) {
@@ -460,14 +466,14 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_DEEP_COUNT, deep_buf[0]);
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_DEEP_SAMPLES, deep_buf[1]);
         }
-        const int report = veil_progress_wanted();
         if (report) veil_progress("march, rows", 0, h);
-        for (int y = 0; y < h && r == VEIL_OK; y += band) { /* (r: the gather's program was made) */
+        for (int y = 0, rows = 0; y < h && r == VEIL_OK; y += rows) { /* (r: the gather's program was made) */
             if (y > 0) { /* the band's first row: size.z of the march's block (uploaded with 0) */
                 u.size[2] = y;
                 glNamedBufferSubData(m->ubo, offsetof(veil_march_block, size), sizeof u.size, u.size);
             }
-            const int rows = h - y < band ? h - y : band;
+            rows = h - y < band ? h - y : band;
+            const double t0 = adapt ? veil_now_ms() : 0.0;
             glDispatchCompute(veil_groups(w, VEIL_MARCH_GROUP), veil_groups(rows, VEIL_MARCH_GROUP), 1);
             if (deep_buf[0]) { /* this band's samples, before the next band overwrites them */
                 glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -479,10 +485,16 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
             }
             if (report) { /* what is reported is done */
                 glFinish();
-                veil_progress("march, rows", y + band < h ? y + band : h, h);
-                if (veil_progress_cancelled() && y + band < h)
+                if (adapt) { /* the next band's rows to take band_seconds at this one's pace (doubling at most) */
+                    const double ms = veil_now_ms() - t0, want = rows * (1e3 * d->band_seconds) / (ms > 1.0 ? ms : 1.0);
+                    const double most = fmin(2.0 * rows, (double)band_cap);
+                    band = (int)(fmax(VEIL_MARCH_GROUP, fmin(want, most)) / VEIL_MARCH_GROUP) * VEIL_MARCH_GROUP;
+                    if (band < VEIL_MARCH_GROUP) band = VEIL_MARCH_GROUP;
+                }
+                veil_progress("march, rows", y + rows, h);
+                if (veil_progress_cancelled() && y + rows < h)
                     r = veil_fail(err, VEIL_ERR_CANCELLED, "cancelled by the progress callback during the march "
-                                  "(%d of %d rows done)", y + band, h);
+                                  "(%d of %d rows done)", y + rows, h);
             } else {
                 glFlush();
             }

@@ -38,11 +38,15 @@
 #define VEIL_MARCH_DISPATCH_WORK ((uint64_t)1 << 28)
 /* On a software rasteriser (llvmpipe marches 6e7 units a second on this
  * project's 2-core machines: the demo's 3.2e8 in 5 s) a band is also the
- * time a cancel waits (issue 41: within 1 s): 2^24 units, about 0.3 s
- * (0.8 s where the estimate is low: a fog's steps; docs/performance.md,
- * "Cancel"). The bands' own cost there is nil: llvmpipe runs each
- * dispatch as it comes. */
+ * time a cancel waits (issue 41: within 1 s), where one can come (a
+ * progress sink): the first band 2^24 units (about 0.3 s; 0.8 s where the
+ * estimate is low: a fog's steps), the next ones sized from the last's pace
+ * to take VEIL_MARCH_BAND_SECONDS. Each band costs a dispatch and a finish
+ * (about 20 ms there: 2^24-unit bands made the shared smoke's march 1.4
+ * times slower), so bands stay as long as the latency allows, and as long
+ * as a dispatch's bound without a sink (docs/performance.md, "Cancel"). */
 #define VEIL_MARCH_SOFTWARE_WORK ((uint64_t)1 << 24)
+#define VEIL_MARCH_BAND_SECONDS 0.3
 
 /* A frame whose estimated work (as VEIL_MARCH_DISPATCH_WORK counts it) is at
  * least this gets a march compiled for its lights (VEIL_LIGHT_LIST: each
@@ -83,7 +87,10 @@ typedef struct veil_march_desc {
                                   longest / gather_cells of the cache's a side); 0: VEIL_GATHER_MAX_CELLS */
     int deep_raw;              /* > 0: raw deep samples a pixel (render/deep.h), read into the image set's
                                   deep image (the march compiled with VEIL_MARCH_DEEP); 0: none */
-    uint64_t band_work;        /* a band's work (VEIL_MARCH_DISPATCH_WORK, or _SOFTWARE_WORK); 0: the first */
+    uint64_t band_work;        /* with a progress sink, a band's work (VEIL_MARCH_DISPATCH_WORK, or _SOFTWARE_WORK
+                                  on a software rasteriser); 0: the first; without one, always the first */
+    double band_seconds;       /* > 0 (with a progress sink): after the first band, each sized from the last's
+                                  pace to take this long (VEIL_MARCH_BAND_SECONDS on a software rasteriser) */
 } veil_march_desc;
 
 /* What the last veil_march_run gathered (render/shaders/cache_gather.comp): rays 0 when it did not. */

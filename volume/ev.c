@@ -9,7 +9,7 @@
 #include "inject_gpu.h"
 
 struct veil_ev {
-    GLuint inject, occupancy; /* programs */
+    GLuint inject, inject_octants, occupancy; /* programs (the splat's octants made when first needed) */
     GLuint tex, occ;          /* the volume and its occupancy bricks */
     GLuint emission;          /* rgba32f emission (0: none) */
     int present, is_sparse;
@@ -174,6 +174,7 @@ void veil_ev_destroy(veil_ev* ev)
     if (!ev) return;
     veil_ev_clear(ev);
     glDeleteProgram(ev->inject);
+    glDeleteProgram(ev->inject_octants);
     glDeleteProgram(ev->occupancy);
     free(ev);
 }
@@ -283,7 +284,7 @@ veil_result veil_ev_build_scene(veil_ev* ev, const veil_scene_volume* v, int n_l
     }
     size_t n = v->particle_count;
     if (r == VEIL_OK && n > 0) r = veil_rbf_bin(g, v->particles, n, &bins, err);
-    if (r == VEIL_OK && n > 0) r = veil_inject_rbf_gpu(ev->inject, g, &bins, ev->tex, splat_evals(ev), err);
+    if (r == VEIL_OK && n > 0) r = veil_inject_rbf_gpu(ev->inject, &ev->inject_octants, g, &bins, ev->tex, splat_evals(ev), err);
     if (r == VEIL_OK) r = build_occupancy(ev, err);
     float* emission = NULL;
     if (r == VEIL_OK) r = veil_scene_volume_emission(v, &emission, err);
@@ -330,7 +331,7 @@ veil_result veil_ev_splat_readback(veil_ev* ev, const veil_grid* g, const veil_p
     if (r == VEIL_OK) {
         static const GLfloat zero = 0.0f;
         glClearTexImage(tex, 0, GL_RED, GL_FLOAT, &zero);
-        r = veil_inject_rbf_gpu(ev->inject, g, &bins, tex, splat_evals(ev), err);
+        r = veil_inject_rbf_gpu(ev->inject, &ev->inject_octants, g, &bins, tex, splat_evals(ev), err);
     }
     if (r == VEIL_OK) r = veil_gl_read_texture(tex, GL_RED, veil_grid_voxels(g), density, "reading back the EV", err);
     glDeleteTextures(1, &tex);

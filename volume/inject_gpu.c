@@ -4,8 +4,9 @@
 
 #include "../core/progress.h"
 #include "../gpu/gl_util.h"
+#include "../gpu/programs.h"
 
-veil_result veil_inject_rbf_gpu(GLuint program, const veil_grid* g, const veil_rbf_bins* b,
+veil_result veil_inject_rbf_gpu(GLuint program, GLuint* program_octants, const veil_grid* g, const veil_rbf_bins* b,
                                 GLuint ev_texture, size_t dispatch_evals, veil_error* err)
 {
     size_t nb = (size_t)b->bricks[0] * b->bricks[1] * b->bricks[2];
@@ -29,29 +30,52 @@ veil_result veil_inject_rbf_gpu(GLuint program, const veil_grid* g, const veil_r
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_BRICK_START, buf[1]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VEIL_BIND_BRICK_LIST, buf[2]);
         glBindImageTexture(VEIL_IMAGE_EV, ev_texture, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
-        /* runs of bricks in their (CSR) order, as many a dispatch as keep its particle-voxel evaluations
-         * under dispatch_evals (a GPU watchdog stops a dispatch of a few seconds; on a software rasteriser
-         * a dispatch is also how late a cancel is seen), one brick at least, at most the work groups a
-         * dispatch may count along x (GL guarantees 65535; 8 a brick: inject_rbf.comp) */
+        /* Without a progress sink: whole layers of bricks, as many a dispatch as keep its particle-voxel
+         * evaluations under VEIL_SPLAT_DISPATCH_EVALS (a GPU watchdog stops a dispatch of a few seconds; at
+         * least one layer), a work group a brick. With one: runs of bricks in their (CSR) order under
+         * dispatch_evals (on a software rasteriser a dispatch is also how late a cancel is seen), one brick
+         * at least, at most the work groups a dispatch may count along x (GL guarantees 65535; 8 a brick
+         * with octants), and a run of crowded bricks (VEIL_SPLAT_OCTANTS_FROM list entries a brick or more)
+         * split into octants (inject_rbf.comp). Measured on llvmpipe (docs/performance.md, "Cancel"): short
+         * dispatches cost the cloud's splat a third more, and a software rasteriser balances its threads
+         * over a 3-D dispatch of whole layers better than over a long run (10^6 particles: 46 s against
+         * 98 s), so the runs only where a cancel may come. */
+        const int report = veil_progress_wanted();
         const size_t nb_all = nb, per_brick = VEIL_BRICK * VEIL_BRICK * VEIL_BRICK, most = 65535 / 8;
-        const size_t cap = dispatch_evals / per_brick; /* list entries a dispatch */
+        const size_t layer = (size_t)b->bricks[0] * (size_t)b->bricks[1];
+        const size_t cap = (report ? dispatch_evals : VEIL_SPLAT_DISPATCH_EVALS) / per_brick; /* list entries */
         const double all = (double)b->list_len * per_brick;
         double done = 0.0;
-        const int report = veil_progress_wanted();
         if (report) veil_progress("RBF splat", 0.0, all);
         size_t k = 0;
         while (k < nb_all) {
-            /* the last k1 in (k, k + most] whose entries from k fit the cap (k + 1 whatever it holds) */
-            size_t lo = k + 1, hi = k + most < nb_all ? k + most : nb_all;
-            while (lo < hi) {
-                const size_t mid = lo + (hi - lo + 1) / 2;
-                if ((size_t)(b->start[mid] - b->start[k]) <= cap) lo = mid;
-                else hi = mid - 1;
+            size_t k1 = k + 1;
+            GLuint groups[3] = {1, 1, 1};
+            int octants = 0;
+            if (!report) { /* whole layers from k (a layer's first brick) */
+                k1 = k + layer;
+                while (k1 < nb_all && (size_t)(b->start[k1 + layer] - b->start[k]) <= cap) k1 += layer;
+                groups[0] = (GLuint)b->bricks[0], groups[1] = (GLuint)b->bricks[1], groups[2] = (GLuint)((k1 - k) / layer);
+            } else { /* the last k1 in (k, k + most] whose entries from k fit the cap (k + 1 whatever it holds) */
+                size_t lo = k + 1, hi = k + most < nb_all ? k + most : nb_all;
+                while (lo < hi) {
+                    const size_t mid = lo + (hi - lo + 1) / 2;
+                    if ((size_t)(b->start[mid] - b->start[k]) <= cap) lo = mid;
+                    else hi = mid - 1;
+                }
+                k1 = lo;
+                octants = b->start[k1] - b->start[k] >= (uint32_t)(k1 - k) * VEIL_SPLAT_OCTANTS_FROM;
+                groups[0] = (GLuint)((octants ? 8 : 1) * (k1 - k));
             }
-            const size_t k1 = lo;
+            if (octants && !*program_octants) {
+                r = veil_gpu_program_variant("volume/shaders/inject_rbf.comp", "#define VEIL_SPLAT_OCTANTS 1\n",
+                                             "octants", program_octants, err);
+                if (r != VEIL_OK) break;
+            }
             blk.dims[3] = (int)k; /* this dispatch's first brick */
             glNamedBufferSubData(block, 0, sizeof blk.dims, blk.dims);
-            glDispatchCompute((GLuint)(8 * (k1 - k)), 1, 1);
+            glUseProgram(octants ? *program_octants : program);
+            glDispatchCompute(groups[0], groups[1], groups[2]);
             glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                             GL_TEXTURE_UPDATE_BARRIER_BIT);
             glFlush();
