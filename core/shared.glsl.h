@@ -514,6 +514,22 @@ VEIL_FN float veil_step_integral(float x)
     return (1.0 - VEIL_EXPF(-x)) / x;
 }
 
+/* exp(-x), a step's transmittance for its optical thickness x >= 0, held at
+ * most 1. IEEE exp gives exp(-x) <= 1 for x >= 0, but a GPU's exp is an
+ * approximate exp2 of x log2(e) and rounds exp(-tiny) to 1 + 1 ulp (an NVIDIA
+ * H200: every empty pixel's T = 1 + 2^-23, issue 42); a ray's product of
+ * such steps would climb further. The bound costs a min a channel. */
+VEIL_FN float veil_step_transmittance(float x) { return VEIL_MINF(VEIL_EXPF(-x), 1.0); }
+
+/* A pixel's alpha from its transmittance per channel: 1 - mean(T), held in
+ * [0, 1]. With every T in [0, 1] the IEEE mean is in [0, 1] too, but a GPU
+ * may divide by 3 as a product with a rounded 1/3; a compositor that
+ * unpremultiplies by a negative alpha flips the colour's sign. */
+VEIL_FN float veil_alpha(float tr, float tg, float tb)
+{
+    return VEIL_MINF(VEIL_MAXF(1.0 - (tr + tg + tb) / 3.0, 0.0), 1.0);
+}
+
 /* Exponential fog, density rho0 * exp(-k) with k linear along a segment of
  * length len from k0 to k1 (k = falloff * <x - origin, n>): the integral is
  *   rho0 * len * exp(-min(k0, k1)) * (1 - exp(-|k1 - k0|)) / |k1 - k0|,

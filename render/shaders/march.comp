@@ -125,7 +125,7 @@ void deep_close(vec3 T, vec3 L, vec3 Lv)
     deep_samples[i + 0u] = c.r;
     deep_samples[i + 1u] = c.g;
     deep_samples[i + 2u] = c.b;
-    deep_samples[i + 3u] = 1.0 - deep_mean(T) / d_T0;
+    deep_samples[i + 3u] = clamp(1.0 - deep_mean(T) / d_T0, 0.0, 1.0); // T <= T0, but a GPU's division may round over
     deep_samples[i + 4u] = d_t0 * d_along;
     deep_samples[i + 5u] = d_t1 * d_along;
     ++d_n;
@@ -392,13 +392,14 @@ void main()
                 precise vec3 w_red = T_red * j_red;
                 Lv += w_red * cache_in(x, dir, f_peak, gather);
             }
-            T_red *= exp(-opt_red);
+            T_red *= vec3(veil_step_transmittance(opt_red.r), veil_step_transmittance(opt_red.g),
+                          veil_step_transmittance(opt_red.b));
             vec3 q = j * single * max(exp(-(med.sigma_t.rgb - med.sigma_s.rgb) * p_mid) - exp(-med.sigma_t.rgb * p_mid), 0.0);
             float yq = dot(q, vec3(VEIL_LUM_R, VEIL_LUM_G, VEIL_LUM_B));
             Q += q;
             q_p += yq * p_mid;
             q_w += yq;
-            vec3 T_next = T * exp(-opt);
+            vec3 T_next = T * vec3(veil_step_transmittance(opt.r), veil_step_transmittance(opt.g), veil_step_transmittance(opt.b));
             float absorbed = dot(T - T_next, vec3(1.0 / 3.0)); // chance the first interaction is in this step
             depth_sum += absorbed * 0.5 * (t + te);
             depth_w += absorbed;
@@ -419,7 +420,8 @@ void main()
     // the cache's part may dip below 0 where its lobe's correction outweighs what came along the ray
     // (a noisy or coarse lobe); radiance is not negative
     Lv = max(Lv, vec3(0.0));
-    imageStore(u_out, p, vec4(L + Lv + T * u.background.rgb, 1.0 - (T.r + T.g + T.b) / 3.0));
+    // T <= 1 by construction (veil_step_transmittance); alpha held in [0, 1] against the mean's rounding
+    imageStore(u_out, p, vec4(L + Lv + T * u.background.rgb, veil_alpha(T.r, T.g, T.b)));
     imageStore(u_aov_v, p, vec4(Lv, 0.0));
     imageStore(u_aov_q, p, vec4(Q, q_w > 0.0 ? min(q_p / q_w, INF) : 0.0));
     imageStore(u_aov_t, p, vec4(T, min(P, INF)));
