@@ -1,4 +1,5 @@
 #include "cli_util.h"
+#include "io/image.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -284,4 +285,27 @@ veil_result veil_cli_commit(veil_cli_outputs* o, int ok, veil_error* err)
     }
     o->count = 0;
     return r;
+}
+
+int veil_cli_exr_option(const char* s, const char* v, veil_exr_format* f, int* rc)
+{
+    *rc = -1;
+    if (strcmp(s, "--exr-type") && strcmp(s, "--exr-compression") && strcmp(s, "--dwa-level")) return 0;
+    if (!v) {
+        *rc = veil_cli_usage_error("%s needs a value", s);
+        return 1;
+    }
+    if (!strcmp(s, "--exr-type")) {
+        if (!strcmp(v, "half") || !strcmp(v, "float")) f->half = !strcmp(v, "half");
+        else *rc = veil_cli_usage_error("--exr-type: expected half or float, got '%s'", v);
+    } else if (!strcmp(s, "--exr-compression")) {
+        int c = veil_exr_compression_parse(v);
+        if (c > 0) f->compression = c;
+        else *rc = veil_cli_usage_error("--exr-compression: expected none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa "
+                                        "or dwab, got '%s'", v);
+    } else if (!veil_cli_parse_float(v, 1e-3f, 1000.0f, &f->dwa_level)) {
+        *rc = veil_cli_usage_error("--dwa-level: expected a compression level in 0.001..1000 (OpenEXR's default 45), "
+                                   "got '%s'", v);
+    }
+    return 1;
 }

@@ -22,6 +22,12 @@ int veil_cli_parse_float(const char* s, float lo, float hi, float* out);
 /* --shutter: "OPEN,CLOSE" (frames relative to the frame, each in [-4, 4],
  * open <= close) sets *set = 1 and sh; "off" sets *set = -1. 1, else 0. */
 int veil_cli_parse_shutter(const char* s, int* set, float sh[2]);
+/* The EXR output's options, for every command that writes one: --exr-type half|float, --exr-compression
+ * NAME (none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab), --dwa-level L (in (0, 1000]). 1 when s is
+ * one of them, its value v parsed into f (*rc EXIT_USAGE with the message printed on a bad or missing
+ * value, else -1); 0 when s is none of them. */
+struct veil_exr_format;
+int veil_cli_exr_option(const char* s, const char* v, struct veil_exr_format* f, int* rc);
 /* What --shutter asked for, over the scene's camera.shutter (set 0: the scene's). */
 void veil_cli_apply_shutter(veil_scene* scene, int set, const float sh[2]);
 /* VEIL_ERR_IO naming the path when the folder it would be written to does

@@ -42,6 +42,7 @@
 typedef struct fog_args {
     const char *frame, *scene, *exr, *png, *depth_channel;
     int depth_is_distance, aovs, stats, no_occluders;
+    veil_exr_format exr_format;
 } fog_args;
 
 static int parse_fog_args(int argc, char** argv, fog_args* a)
@@ -53,6 +54,12 @@ static int parse_fog_args(int argc, char** argv, fog_args* a)
         if (!strcmp(s, "--aovs")) { a->aovs = 1; continue; }
         if (!strcmp(s, "--stats")) { a->stats = 1; continue; }
         if (!strcmp(s, "--no-occluders")) { a->no_occluders = 1; continue; }
+        int xrc;
+        if (veil_cli_exr_option(s, v, &a->exr_format, &xrc)) {
+            if (xrc >= 0) return xrc;
+            ++i;
+            continue;
+        }
         int takes = !strcmp(s, "-o") || !strcmp(s, "--png") || !strcmp(s, "--scene") ||
                     !strcmp(s, "--depth-channel") || !strcmp(s, "--depth-is");
         if (takes && !v) return veil_cli_usage_error("%s needs a value", s);
@@ -207,7 +214,8 @@ int veil_cmd_fog(int argc, char** argv)
         veil_cli_progress_end();
         if (r != VEIL_OK && veil_cli_exit_code(r) == EXIT_INPUT) veil_cli_prefix_error(&err, a.scene);
     }
-    if (r == VEIL_OK) r = veil_cli_write_frame(&im, a.exr, a.png, NULL, a.aovs, NULL, &err); /* all or nothing */
+    if (r == VEIL_OK) r = veil_cli_write_frame(&im, a.exr, a.png, NULL, a.aovs, &(veil_exr_meta){.format = a.exr_format},
+                                                  &err); /* all or nothing */
     if (r == VEIL_OK && a.stats) veil_cli_print_stages(&st);
     if (r == VEIL_OK) printf("wrote %s%s%s (depth from channel %s, as %s)\n", a.exr, a.png ? " and " : "",
                              a.png ? a.png : "", channel, a.depth_is_distance ? "distance along the ray" : "Z");

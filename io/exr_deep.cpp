@@ -10,6 +10,10 @@
 // catches every exception and maps it to a result with its message; no C++
 // type crosses io/exr_deep.h.
 //
+// The flat writer (io/exr.c) comes here too for DWAA and DWAB, which
+// OpenEXRCore 3.1 cannot encode either (EXR_ERR_FEATURE_NOT_IMPLEMENTED,
+// "DWA/A compression not yet implemented in C"): veil__exr_write_imf.
+//
 // The bytes go through an Imf::OStream over the descriptor of a temporary
 // file beside the target (io/tempfile.h), renamed into place only when the
 // whole file is written and closed; on failure the temporary is removed and
@@ -34,7 +38,10 @@
 #include <ImfHeader.h>
 #include <ImfIO.h>
 #include <ImfIntAttribute.h>
+#include <ImfFrameBuffer.h>
+#include <Imath/half.h>
 #include <ImfMatrixAttribute.h>
+#include <ImfOutputFile.h>
 #include <ImfPartType.h>
 #include <ImfStringAttribute.h>
 #include <Iex.h>
@@ -72,17 +79,17 @@ private:
 };
 
 template <typename F>
-veil_result guarded(veil_error* err, const char* path, F&& f) noexcept
+veil_result guarded(veil_error* err, const char* path, F&& f, const char* what = "the deep OpenEXR file") noexcept
 {
     try {
         f();
         return VEIL_OK;
     } catch (const std::bad_alloc&) {
-        return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory writing the deep OpenEXR file", path);
+        return veil_fail(err, VEIL_ERR_OOM, "%s: out of memory writing %s", path, what);
     } catch (const std::exception& e) {
-        return veil_fail(err, VEIL_ERR_IO, "%s: cannot write the deep OpenEXR file (OpenEXR said: %s)", path, e.what());
+        return veil_fail(err, VEIL_ERR_IO, "%s: cannot write %s (OpenEXR said: %s)", path, what, e.what());
     } catch (...) {
-        return veil_fail(err, VEIL_ERR_IO, "%s: cannot write the deep OpenEXR file (unknown C++ exception)", path);
+        return veil_fail(err, VEIL_ERR_IO, "%s: cannot write %s (unknown C++ exception)", path, what);
     }
 }
 
@@ -136,6 +143,40 @@ void write_file(int fd, const char* path, const veil_deep_image* d, const veil_e
 }
 
 } // namespace
+
+extern "C" veil_result veil__exr_write_imf(int fd, const char* path, int width, int height, int n,
+                                           const char* const* names, const float* const* planes,
+                                           const veil_exr_meta* meta, veil_error* err)
+{
+    return guarded(err, path, [&] {
+        const veil_exr_format* fmt = meta ? &meta->format : nullptr;
+        Imf::Header header(width, height);
+        header.compression() = fmt && fmt->compression == VEIL_EXR_DWAB ? Imf::DWAB_COMPRESSION : Imf::DWAA_COMPRESSION;
+        if (fmt && fmt->dwa_level > 0.0f) header.dwaCompressionLevel() = fmt->dwa_level;
+        Imf::FrameBuffer fb;
+        // the C++ library converts no float frame buffer into a half channel: half planes made here
+        const size_t pixels = (size_t)width * (size_t)height;
+        std::vector<std::vector<Imath::half>> halves;
+        halves.reserve((size_t)n);
+        for (int c = 0; c < n; ++c) {
+            if (fmt && fmt->half && !veil_exr_keeps_float(names[c])) { // a half channel
+                header.channels().insert(names[c], Imf::Channel(Imf::HALF));
+                halves.emplace_back(planes[c], planes[c] + pixels); // float to half: round to nearest even
+                fb.insert(names[c], Imf::Slice(Imf::HALF, (char*)halves.back().data(), sizeof(Imath::half),
+                                               sizeof(Imath::half) * (size_t)width));
+            } else {
+                header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+                fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)planes[c], sizeof(float), sizeof(float) * (size_t)width));
+            }
+        }
+        add_meta(header, meta);
+        fd_ostream os(fd, path);
+        const int threads = fmt && fmt->threads > 0 ? fmt->threads : veil_exr_threads();
+        Imf::OutputFile file(os, header, threads > 1 ? threads : 0);
+        file.setFrameBuffer(fb);
+        file.writePixels(height);
+    }, "the OpenEXR file");
+}
 
 extern "C" void veil_deep_image_free(veil_deep_image* d)
 {

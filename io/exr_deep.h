@@ -48,6 +48,13 @@ void veil_deep_image_free(veil_deep_image* d); /* accepts NULL and zeroed images
 veil_result veil_write_deep_exr(const char* path, const veil_deep_image* d, const veil_exr_meta* meta,
                                 veil_error* err);
 
+/* The flat writer's way for DWAA and DWAB (io/exr.c), which OpenEXRCore 3.1 cannot encode either
+ * ("DWA/A compression not yet implemented in C"): the n planes onto the open descriptor fd of the
+ * writer's temporary file through the C++ library, as veil_write_exr_planes_meta would write them
+ * (meta->format's half and level, its threads); VEIL_ERR_IO naming path with OpenEXR's message. */
+veil_result veil__exr_write_imf(int fd, const char* path, int width, int height, int n, const char* const* names,
+                                const float* const* planes, const veil_exr_meta* meta, veil_error* err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -22,6 +22,9 @@ typedef struct exr_msgs {
 
 extern _Thread_local exr_msgs* veil__exr_tls_msgs;
 
+/* OpenEXRCore's compression for a VEIL_EXR_* (io/image.h). */
+int veil__exr_compression_of(int compression);
+
 /* The context initializer's error_handler_fn. */
 void veil__exr_on_error(exr_const_context_t ctxt, exr_result_t code, const char* msg);
 

@@ -31,6 +31,34 @@ veil_result veil_write_exr_planes(const char* path, int width, int height, int n
  * (x right, y up, z the viewing direction), worldToNDC onto the image
  * (0, 0) top left, (1, 1) bottom right, after the division by w. */
 #define VEIL_EXR_META_STRINGS 8
+
+/* How an EXR's pixels are stored, as Blender's and Nuke's EXR outputs offer
+ * (all zero: 32-bit float, ZIP, the chunks compressed on every core). */
+enum {
+    VEIL_EXR_DEFAULT = 0, /* ZIP */
+    VEIL_EXR_NONE, VEIL_EXR_RLE, VEIL_EXR_ZIPS, VEIL_EXR_ZIP, VEIL_EXR_PIZ, VEIL_EXR_PXR24, VEIL_EXR_B44,
+    VEIL_EXR_B44A, VEIL_EXR_DWAA, VEIL_EXR_DWAB,
+    VEIL_EXR_COMPRESSIONS
+};
+#define VEIL_EXR_MAX_THREADS 64
+typedef struct veil_exr_format {
+    int half;        /* 1: channels as 16-bit half, except those veil_exr_keeps_float names */
+    int compression; /* a VEIL_EXR_* above (PXR24, B44, B44A, DWAA and DWAB are lossy) */
+    float dwa_level; /* DWAA / DWAB's compression level (OpenEXR's default 45 when 0) */
+    int threads;     /* threads compressing the chunks (0: veil_exr_threads()) */
+} veil_exr_format;
+
+/* The compression's name ("zip", "none", "rle", "zips", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"), and
+ * back (-1: no such name). */
+const char* veil_exr_compression_name(int compression);
+int veil_exr_compression_parse(const char* name);
+/* 1 for the channels that stay 32-bit float in a half file: distances ("Z", "ZBack", "depth") and the
+ * density integral "P" (half's 11-bit significand would step a depth of 100 m by 6 cm). */
+int veil_exr_keeps_float(const char* name);
+/* The threads an EXR's chunks are compressed on: the machine's online cores (VEIL_EXR_THREADS in the
+ * environment overrides), at most VEIL_EXR_MAX_THREADS. */
+int veil_exr_threads(void);
+
 typedef struct veil_exr_meta {
     int has_frame;
     int frame;                    /* int attribute "frame" */
@@ -39,6 +67,7 @@ typedef struct veil_exr_meta {
     float world_to_ndc[16];       /* m44f "worldToNDC", row-major */
     const char* strings[VEIL_EXR_META_STRINGS][2]; /* string attributes: name, value */
     int n_strings;
+    veil_exr_format format;       /* how the pixels are stored */
 } veil_exr_meta;
 
 /* veil_write_exr_planes with header attributes (meta may be NULL). */

@@ -4,6 +4,7 @@
 
 #include "support/check.h"
 #include "io/image.h"
+#include "io/exr_io.h"
 #include "support/exr_core.h"
 #include "support/temp_files.h"
 
@@ -779,9 +780,108 @@ static void test_read_failures(void)
     free(px);
 }
 
+
+/* ------------------------------------------------------------------------ */
+/* The output formats (issue 42): every compression OpenEXRCore encodes, float and half, on one and on
+ * several threads. Bounds:
+ *  - none, rle, zips, zip, piz: lossless: float channels bit for bit; a half channel is the float
+ *    rounded to half, within 2^-11 relative for values in half's normal range (the image's are in
+ *    [1e-3, 1e3]; Z's +infinity stays infinite);
+ *  - pxr24: a float channel rounded to 24 bits (a 15-bit significand): within 2^-16 relative; half
+ *    channels lossless (as above);
+ *  - b44, b44a: float channels stored as they are (bit for bit); half channels are the codec's (not
+ *    checked here beyond being finite, which a wrong channel order would still satisfy: the lossless
+ *    codecs check that);
+ *  - the chunks compressed on 1 and on 5 threads make the same bytes (the chunks are written in
+ *    order, whichever thread compressed them).
+ * The channels Z, depth and P stay float in a half file (veil_exr_keeps_float). */
+#define FW 97
+#define FH 83
+#define FN 7
+static const char* const g_fmt_names[FN] = {"R", "G", "B", "A", "Z", "depth", "P"};
+
+static int read_bytes(const char* path, unsigned char** out, size_t* n)
+{
+    FILE* f = fopen(path, "rb");
+    if (!f) return 0;
+    fseek(f, 0, SEEK_END);
+    long len = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    *out = malloc(len > 0 ? (size_t)len : 1);
+    *n = *out && len >= 0 ? fread(*out, 1, (size_t)len, f) : 0;
+    fclose(f);
+    return *out && *n == (size_t)len;
+}
+
+static void test_exr_formats(void)
+{
+    float* planes[FN];
+    uint64_t seed = 4242;
+    for (int c = 0; c < FN; ++c) {
+        planes[c] = malloc(FW * FH * sizeof(float));
+        for (int i = 0; i < FW * FH; ++i) /* log-uniform in [1e-3, 1e3] */
+            planes[c][i] = (float)pow(10.0, -3.0 + 6.0 * ((double)((seed = seed * 6364136223846793005ULL + 1442695040888963407ULL) >> 11) / 9007199254740992.0));
+    }
+    planes[4][5] = INFINITY; /* Z where the ray met nothing */
+    char a[512], b[512];
+    path_in(a, sizeof a, "fmt1.exr");
+    path_in(b, sizeof b, "fmt5.exr");
+    static const int codecs[] = {VEIL_EXR_NONE, VEIL_EXR_RLE, VEIL_EXR_ZIPS, VEIL_EXR_ZIP, VEIL_EXR_PIZ, VEIL_EXR_PXR24,
+                                 VEIL_EXR_B44, VEIL_EXR_B44A, VEIL_EXR_DEFAULT};
+    float* got = malloc(FW * FH * sizeof(float));
+    for (size_t k = 0; k < sizeof codecs / sizeof *codecs; ++k)
+        for (int half = 0; half <= 1; ++half) {
+            const int codec = codecs[k];
+            const char* name = veil_exr_compression_name(codec);
+            veil_exr_meta m1 = {.format = {.half = half, .compression = codec, .threads = 1}}, m5 = m1;
+            m5.format.threads = 5;
+            veil_error err = {0};
+            CHECK(veil_write_exr_planes_meta(a, FW, FH, FN, g_fmt_names, (const float* const*)planes, &m1, &err) == VEIL_OK,
+                  "%s %s, 1 thread: %s", name, half ? "half" : "float", err.msg);
+            CHECK(veil_write_exr_planes_meta(b, FW, FH, FN, g_fmt_names, (const float* const*)planes, &m5, &err) == VEIL_OK,
+                  "%s %s, 5 threads: %s", name, half ? "half" : "float", err.msg);
+            unsigned char *ba = NULL, *bb = NULL;
+            size_t na = 0, nb = 0;
+            CHECK(read_bytes(a, &ba, &na) && read_bytes(b, &bb, &nb) && na == nb && !memcmp(ba, bb, na),
+                  "%s %s: 1 and 5 threads wrote different files (%zu and %zu bytes)", name, half ? "half" : "float", na, nb);
+            free(ba);
+            free(bb);
+            for (int c = 0; c < FN; ++c) {
+                memset(got, 0, FW * FH * sizeof(float));
+                exr_facts f = core_inspect(b, g_fmt_names[c], got);
+                CHECK(f.ok && (int)f.compression == veil__exr_compression_of(codec), "%s: compression %d", name,
+                      (int)f.compression);
+                const int is_half = half && !veil_exr_keeps_float(g_fmt_names[c]);
+                int type_ok = 0;
+                for (int i = 0; i < f.nchans; ++i)
+                    if (!strcmp(f.names[i], g_fmt_names[c])) type_ok = f.types[i] == (is_half ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT);
+                CHECK(type_ok, "%s %s: channel %s is not %s", name, half ? "half" : "float", g_fmt_names[c],
+                      is_half ? "half" : "float");
+                const int lossy_half = is_half && (codec == VEIL_EXR_B44 || codec == VEIL_EXR_B44A);
+                const double rel = is_half ? (lossy_half ? -1.0 : ldexp(1.0, -11)) : codec == VEIL_EXR_PXR24 ? ldexp(1.0, -16) : 0.0;
+                int bad = 0, first = -1;
+                for (int i = 0; i < FW * FH; ++i) {
+                    const double want = planes[c][i], v = got[i];
+                    const int ok = rel < 0.0 ? isfinite(v) || isinf(want) : isinf(want) ? v == want : fabs(v - want) <= rel * fabs(want);
+                    if (!ok && !bad++) first = i;
+                }
+                CHECK(!bad, "%s %s, channel %s: %d values off (first at %d: %.9g for %.9g; bound %g relative)", name,
+                      half ? "half" : "float", g_fmt_names[c], bad, first, first >= 0 ? (double)got[first] : 0.0,
+                      first >= 0 ? (double)planes[c][first] : 0.0, rel);
+            }
+            unlink(a);
+            unlink(b);
+        }
+    free(got);
+    for (int c = 0; c < FN; ++c) free(planes[c]);
+    CHECK(veil_exr_compression_parse("dwaa") == VEIL_EXR_DWAA && veil_exr_compression_parse("zip") == VEIL_EXR_ZIP &&
+          veil_exr_compression_parse("ZIP") < 0 && veil_exr_compression_parse("") < 0, "%s", "compression names");
+}
+
 int main(void)
 {
     if (!test_dir_begin("test_exr")) return 1;
+    test_exr_formats();
     test_exr_roundtrip();
     test_exr_channels();
     test_exr_planes();
