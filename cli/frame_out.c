@@ -1,6 +1,12 @@
+#define _POSIX_C_SOURCE 200809L
 #include "frame_out.h"
 
+#include <pthread.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/clock.h"
 
 #include "cli_util.h"
 
@@ -34,4 +40,140 @@ void veil_cli_print_stages(const veil_render_stats* st)
     for (int i = 0; i < VEIL_STAGE_COUNT; ++i)
         printf("%-10s %9.2f ms  (%s: %s)\n", veil_stage_name((veil_stage_id)i), st->stage[i].ms,
                veil_stage_status_name(st->stage[i].status), st->stage[i].why);
+}
+
+/* ---- the writer thread ---------------------------------------------------------------------------- */
+
+typedef struct writer_job {
+    veil_image_set im;
+    long frame;
+    char exr[4096], png[4096], deep[4096];
+    int has_png, has_deep, aovs, has_meta;
+    veil_exr_meta meta;
+    char strings[VEIL_EXR_META_STRINGS][2][512]; /* meta's strings, copied */
+} writer_job;
+
+struct veil_cli_writer {
+    pthread_t thread;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    int busy, quit, stats;   /* busy: a job waits or is being written */
+    writer_job job;
+    veil_result r;           /* the first failure */
+    veil_error err;
+    double write_ms, waited_ms;
+};
+
+static void* writer_main(void* arg)
+{
+    veil_cli_writer* w = arg;
+    pthread_mutex_lock(&w->mu);
+    for (;;) {
+        while (!w->busy && !w->quit) pthread_cond_wait(&w->cv, &w->mu);
+        if (!w->busy) break; /* quit, nothing left */
+        pthread_mutex_unlock(&w->mu);
+        writer_job* j = &w->job;
+        const double t0 = veil_now_ms();
+        veil_error err = {0};
+        veil_result r = veil_cli_write_frame(&j->im, j->exr, j->has_png ? j->png : NULL, j->has_deep ? j->deep : NULL,
+                                             j->aovs, j->has_meta ? &j->meta : NULL, &err);
+        const double ms = veil_now_ms() - t0;
+        veil_image_set_free(&j->im);
+        if (r == VEIL_OK && w->stats) {
+            flockfile(stdout);
+            printf("write      %9.2f ms  (frame %ld, its own thread)\n", ms, j->frame);
+            funlockfile(stdout);
+        }
+        pthread_mutex_lock(&w->mu);
+        w->write_ms += ms;
+        if (r != VEIL_OK && w->r == VEIL_OK) w->r = r, w->err = err;
+        w->busy = 0;
+        pthread_cond_broadcast(&w->cv);
+    }
+    pthread_mutex_unlock(&w->mu);
+    return NULL;
+}
+
+veil_result veil_cli_writer_start(int stats, veil_cli_writer** out, veil_error* err)
+{
+    *out = NULL;
+    veil_cli_writer* w = calloc(1, sizeof *w);
+    if (!w) return veil_fail(err, VEIL_ERR_OOM, "out of memory for the frame writer");
+    w->stats = stats;
+    pthread_mutex_init(&w->mu, NULL);
+    pthread_cond_init(&w->cv, NULL);
+    if (pthread_create(&w->thread, NULL, writer_main, w) != 0) {
+        pthread_cond_destroy(&w->cv);
+        pthread_mutex_destroy(&w->mu);
+        free(w);
+        return veil_fail(err, VEIL_ERR_OOM, "cannot start the frame writer's thread");
+    }
+    *out = w;
+    return VEIL_OK;
+}
+
+/* Copies src (up to cap bytes with its NUL); 0 when it does not fit. */
+static int copy_text(char* dst, size_t cap, const char* src)
+{
+    size_t n = strlen(src);
+    if (n >= cap) return 0;
+    memcpy(dst, src, n + 1);
+    return 1;
+}
+
+veil_result veil_cli_writer_put(veil_cli_writer* w, veil_image_set* im, long frame, const char* exr, const char* png,
+                                const char* deep, int aovs, const veil_exr_meta* meta, veil_error* err)
+{
+    const double t0 = veil_now_ms();
+    pthread_mutex_lock(&w->mu);
+    while (w->busy) pthread_cond_wait(&w->cv, &w->mu);
+    w->waited_ms += veil_now_ms() - t0;
+    veil_result r = w->r;
+    if (r != VEIL_OK) *err = w->err;
+    pthread_mutex_unlock(&w->mu);
+    if (r != VEIL_OK) return r; /* an earlier frame failed: nothing after it is written */
+    writer_job* j = &w->job; /* the writer is idle: the job is ours until busy is set */
+    memset(j, 0, sizeof *j);
+    j->frame = frame, j->aovs = aovs, j->has_png = png != NULL, j->has_deep = deep != NULL;
+    int ok = copy_text(j->exr, sizeof j->exr, exr) && (!png || copy_text(j->png, sizeof j->png, png)) &&
+             (!deep || copy_text(j->deep, sizeof j->deep, deep));
+    if (meta) {
+        j->has_meta = 1;
+        j->meta = *meta;
+        for (int i = 0; i < meta->n_strings && i < VEIL_EXR_META_STRINGS && ok; ++i)
+            for (int k = 0; k < 2 && ok; ++k) {
+                const char* t = meta->strings[i][k];
+                ok = !t || copy_text(j->strings[i][k], sizeof j->strings[i][k], t);
+                j->meta.strings[i][k] = t ? j->strings[i][k] : NULL;
+            }
+    }
+    if (!ok) return veil_fail(err, VEIL_ERR_INVALID, "%s: a path or header attribute too long", exr);
+    j->im = *im;
+    memset(im, 0, sizeof *im);
+    pthread_mutex_lock(&w->mu);
+    w->busy = 1;
+    pthread_cond_broadcast(&w->cv);
+    pthread_mutex_unlock(&w->mu);
+    return VEIL_OK;
+}
+
+veil_result veil_cli_writer_finish(veil_cli_writer* w, double* write_ms, double* waited_ms, veil_error* err)
+{
+    if (!w) return VEIL_OK;
+    const double t0 = veil_now_ms();
+    pthread_mutex_lock(&w->mu);
+    w->quit = 1;
+    pthread_cond_broadcast(&w->cv);
+    pthread_mutex_unlock(&w->mu);
+    pthread_join(w->thread, NULL); /* it writes what it holds first */
+    w->waited_ms += veil_now_ms() - t0;
+    veil_result r = w->r;
+    if (r != VEIL_OK && err) *err = w->err;
+    if (write_ms) *write_ms = w->write_ms;
+    if (waited_ms) *waited_ms = w->waited_ms;
+    veil_image_set_free(&w->job.im);
+    pthread_cond_destroy(&w->cv);
+    pthread_mutex_destroy(&w->mu);
+    free(w);
+    return r;
 }

@@ -17,6 +17,22 @@
 veil_result veil_cli_write_frame(const veil_image_set* im, const char* exr, const char* png, const char* deep,
                                  int aovs, const veil_exr_meta* meta, veil_error* err);
 
+/* A frame writer on its own thread (issue 42): a turntable renders frame N + 1 while frame N is
+ * written. veil_cli_writer_put hands a frame over (the image set moved out of *im, which is left
+ * empty; exr, png, deep and meta's strings copied) once the writer is free: at most one frame
+ * waits while one renders, so two frames' images are held at most. Each frame is written as
+ * veil_cli_write_frame writes it (staged, then renamed: a signal or an error leaves no half
+ * file, and every frame finished before it in place). A write's failure is returned by the next
+ * put or by finish, and no frame after it is written. With `stats`, each frame's write time is
+ * printed as "write      T ms (frame F, its own thread)". */
+typedef struct veil_cli_writer veil_cli_writer;
+veil_result veil_cli_writer_start(int stats, veil_cli_writer** out, veil_error* err);
+veil_result veil_cli_writer_put(veil_cli_writer* w, veil_image_set* im, long frame, const char* exr, const char* png,
+                                const char* deep, int aovs, const veil_exr_meta* meta, veil_error* err);
+/* Waits for the frames handed over, ends the thread, frees w (NULL: nothing); the first failure, if
+ * any. *write_ms (may be NULL): the writes' time in all, *waited_ms the time put waited for them. */
+veil_result veil_cli_writer_finish(veil_cli_writer* w, double* write_ms, double* waited_ms, veil_error* err);
+
 /* The --stats line of a deep image's merge (render/deep.h). */
 void veil_cli_print_deep(const veil_deep_report* d);
 

@@ -25,6 +25,7 @@ typedef struct render_args {
     veil_opv_method method;
     veil_quality quality;
     int stats, explain, aovs;
+    veil_exr_format exr_format;
     int shutter_set; /* --shutter: 1 the values, -1 off, 0 the scene's */
     float shutter[2];
 } render_args;
@@ -38,6 +39,12 @@ static int parse_render_args(int argc, char** argv, render_args* a)
         if (!strcmp(s, "--stats")) { a->stats = 1; continue; }
         if (!strcmp(s, "--explain")) { a->explain = 1; continue; }
         if (!strcmp(s, "--aovs")) { a->aovs = 1; continue; }
+        int xrc;
+        if (veil_cli_exr_option(s, v, &a->exr_format, &xrc)) {
+            if (xrc >= 0) return xrc;
+            ++i;
+            continue;
+        }
         int takes = !strcmp(s, "-o") || !strcmp(s, "--png") || !strcmp(s, "--width") || !strcmp(s, "--height") ||
                     !strcmp(s, "--step") || !strcmp(s, "--seed") || !strcmp(s, "--method") ||
                     !strcmp(s, "--turntable") || !strcmp(s, "--quality") || !strcmp(s, "--od-spacing") ||
@@ -161,6 +168,8 @@ int veil_cmd_render(int argc, char** argv)
     r = veil_renderer_create_deferred(NULL, &ren, &err);
     long frames = a.frames > 0 ? a.frames : 1;
     veil_image_set im = {0};
+    veil_cli_writer* writer = NULL;
+    char last[8300] = "";
     for (long f = 0; f < frames && r == VEIL_OK; ++f) {
         veil_camera cam = veil_camera_of_frame(&scene.camera, f, frames);
         veil_render_opts opts = {.width = (int)a.width, .height = (int)a.height, .step_voxels = a.step,
@@ -178,20 +187,38 @@ int veil_cmd_render(int argc, char** argv)
         if (r == VEIL_OK) r = veil_frame_path(a.exr, f, a.frames > 0, exr, sizeof exr, &err);
         if (r == VEIL_OK && a.png) r = veil_frame_path(a.png, f, a.frames > 0, png, sizeof png, &err);
         if (r == VEIL_OK && a.deep) r = veil_frame_path(a.deep, f, a.frames > 0, deep, sizeof deep, &err);
+        const veil_exr_meta meta = {.format = a.exr_format};
+        if (frames > 1) { /* a turntable's frame is written on its own thread while the next renders */
+            if (r == VEIL_OK && a.stats) {
+                flockfile(stdout);
+                printf("frame %ld\n", f);
+                veil_cli_print_stages(&st);
+                if (a.deep) veil_cli_print_deep(&st.deep);
+                funlockfile(stdout);
+            }
+            if (r == VEIL_OK && !writer) r = veil_cli_writer_start(a.stats, &writer, &err);
+            if (r == VEIL_OK)
+                r = veil_cli_writer_put(writer, &im, f, exr, a.png ? png : NULL, a.deep ? deep : NULL, a.aovs, &meta,
+                                        &err);
+            if (r != VEIL_OK) break;
+            if (f == frames - 1) snprintf(last, sizeof last, "%s%s%s", exr, a.png ? " and " : "", a.png ? png : "");
+            continue;
+        }
         double t_write = veil_now_ms();
-        if (r == VEIL_OK)
-            r = veil_cli_write_frame(&im, exr, a.png ? png : NULL, a.deep ? deep : NULL, a.aovs, NULL, &err);
+        if (r == VEIL_OK) r = veil_cli_write_frame(&im, exr, a.png ? png : NULL, a.deep ? deep : NULL, a.aovs, &meta, &err);
         if (r != VEIL_OK) break;
         if (a.stats) {
-            if (frames > 1) printf("frame %ld\n", f);
             veil_cli_print_stages(&st);
             if (a.deep) veil_cli_print_deep(&st.deep);
             printf("write      %9.2f ms\n", veil_now_ms() - t_write);
         }
-        if (frames == 1 || f == frames - 1)
-            printf("wrote %s%s%s%s in %.2f s\n", frames > 1 ? "frames up to " : "", exr, a.png ? " and " : "",
-                   a.png ? png : "", (veil_now_ms() - t_start) * 1e-3);
+        printf("wrote %s%s%s in %.2f s\n", exr, a.png ? " and " : "", a.png ? png : "", (veil_now_ms() - t_start) * 1e-3);
     }
+    veil_error werr = {0};
+    veil_result wr = veil_cli_writer_finish(writer, NULL, NULL, &werr); /* the last frames written */
+    if (r == VEIL_OK && wr != VEIL_OK) r = wr, err = werr;
+    if (r == VEIL_OK && frames > 1)
+        printf("wrote frames up to %s in %.2f s\n", last, (veil_now_ms() - t_start) * 1e-3);
     veil_image_set_free(&im);
     veil_renderer_destroy(ren);
     veil_scene_free(&scene);

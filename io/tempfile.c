@@ -39,22 +39,30 @@ static pthread_t g_main;
 static volatile sig_atomic_t g_have_main;
 static sigset_t g_held_old;
 
+/* Threads register and forget (a turntable's writer beside its renderer): the slots are claimed under
+ * a lock, which the handler never takes (it only reads the flags). */
+static pthread_mutex_t g_slots_lock = PTHREAD_MUTEX_INITIALIZER;
+
 void veil_temp_register(const char* path)
 {
     if (!path || strlen(path) >= sizeof g_paths[0]) return;
+    pthread_mutex_lock(&g_slots_lock);
     for (int i = 0; i < VEIL_TEMP_SLOTS; ++i)
         if (!g_used[i]) {
             memcpy(g_paths[i], path, strlen(path) + 1);
             g_used[i] = 1;
-            return;
+            break;
         }
+    pthread_mutex_unlock(&g_slots_lock);
 }
 
 void veil_temp_forget(const char* path)
 {
     if (!path) return;
+    pthread_mutex_lock(&g_slots_lock);
     for (int i = 0; i < VEIL_TEMP_SLOTS; ++i)
         if (g_used[i] && !strcmp(g_paths[i], path)) g_used[i] = 0;
+    pthread_mutex_unlock(&g_slots_lock);
 }
 
 void veil_temp_register_folder(const char* dir, const char* prefix, int digits, const char* suffix)

@@ -386,7 +386,47 @@ def _number(label, v, lo, hi, integer=False):
     return v
 
 
-def _render_one(ctx, scn, width, height, seed, step_voxels, frame, frames, progress, output, aovs, exposure):
+class _FrameWriter:
+    """A turntable's frames written on a thread of their own while the next renders (issue 42): at most one
+    frame in flight (put waits for the one before), libveil's writers release the GIL and stage each file
+    beside its target (renamed into place when whole), so a frame is either whole or absent."""
+
+    def __init__(self):
+        self._thread = None
+        self._error = None
+
+    def wait(self):
+        """Waits for the frame in flight; its write's exception, if it failed."""
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+        if self._error is not None:
+            exc, self._error = self._error, None
+            raise exc
+
+    def raise_if_failed(self):
+        """The last frame's write error, if it has failed already (before rendering another for nothing)."""
+        if self._thread is not None and not self._thread.is_alive():
+            self.wait()
+
+    def put(self, img, path, aovs, exposure):
+        """Writes img to path on the writer's thread and destroys it there."""
+        self.wait()
+
+        def run():
+            try:
+                _write(img, path, aovs, exposure)
+            except BaseException as exc:  # raised on the caller's thread by the next wait
+                self._error = exc
+            finally:
+                _Lib.lib.veil_image_destroy(img)
+
+        self._thread = threading.Thread(target=run, name="veil frame writer")
+        self._thread.start()
+
+
+def _render_one(ctx, scn, width, height, seed, step_voxels, frame, frames, progress, output, aovs, exposure,
+                writer=None):
     lib = _Lib.lib
     handle = ctx._use()
     fn, close_bar = _progress.resolve(progress, "frame %d: " % frame if frames > 1 else "")
@@ -427,11 +467,16 @@ def _render_one(ctx, scn, width, height, seed, step_voxels, frame, frames, progr
         out.frame = frame
         if output is not None:
             _check_not_scene(output, scn.file)
-            _write(img, output, aovs, exposure)
+            if writer is not None:
+                writer.put(img, output, aovs, exposure)
+                img = None  # the writer's now: it destroys it
+            else:
+                _write(img, output, aovs, exposure)
             out.path = os.fspath(output)
         return out
     finally:
-        lib.veil_image_destroy(img)
+        if img is not None:
+            lib.veil_image_destroy(img)
 
 
 def render(scene, grids=None, quality=None, size=None, seed=0, step_voxels=None, frame=0, frames=0,
@@ -523,7 +568,11 @@ def turntable(scene, frames, grids=None, quality=None, size=None, seed=0, step_v
     `frames` equal steps (frame 0: the scene's camera). The scene is read
     once and every frame renders with one context, so the medium is injected
     and its lights propagated once. output: a path with one run of '#'
-    replaced by the zero-padded frame number ("out/frame.####.exr"). Every
+    replaced by the zero-padded frame number ("out/frame.####.exr"); each
+    frame's file is written on a thread of its own while the next frame
+    renders: it is whole once the next frame is yielded or the generator
+    ends (a file is never there half-written), and a failed write raises
+    then. Every
     other argument and the dicts are as veil.render's. A generator: frames
     render as they are asked for; closing it early releases the scene.
     """
@@ -548,13 +597,23 @@ def turntable(scene, frames, grids=None, quality=None, size=None, seed=0, step_v
 def _turntable(ctx, scene, grids, quality, base_dir, width, height, seed, step, frames, start, stop, progress,
                output, aovs, exposure):
     scn = _Scene(scene, grids, quality, base_dir, progress)
+    writer = _FrameWriter() if output is not None else None
     try:
         ctx = ctx if ctx is not None else default_context()
         for f in range(start, stop):
             path = _frame_path(output, f) if output is not None else None
-            yield f, _render_one(ctx, scn, width, height, seed, step, f, frames, progress, path, aovs, exposure)
+            if writer is not None:
+                writer.raise_if_failed()
+            yield f, _render_one(ctx, scn, width, height, seed, step, f, frames, progress, path, aovs, exposure,
+                                 writer)
+        if writer is not None:
+            writer.wait()  # the last frame whole before the generator ends
     finally:
-        scn.close()
+        try:
+            if writer is not None:
+                writer.wait()
+        finally:
+            scn.close()
 
 
 def _close_main_default():

@@ -95,4 +95,27 @@ rm "$tmp/two/t.1007.exr"
   > /dev/null 2> "$tmp/shard.err"
 [ $? -eq 1 ] && grep -q "1 of the range's 4 frames are not written yet (frame 1007 first)" "$tmp/shard.err" ||
   fail "a sheet over missing frames: $(cat "$tmp/shard.err")"
+# frames are written on a thread of their own while the next renders (cli/frame_out.h): a write that
+# fails (a file size limit under a frame's size, SIGXFSZ ignored so the write fails with EFBIG) ends
+# the run naming the frame, with no frame after it rendered to the end and no temporary left
+mkdir -p "$tmp/limited"
+bash -c 'trap "" XFSZ; ulimit -f 4; exec "$@"' _ "$veil" turntable "$scene" -o "$tmp/limited/t.####.exr" \
+  --frames 6 --width 96 --height 72 > "$tmp/limited.txt" 2> "$tmp/limited.err"; rc=$?
+[ $rc -eq 1 ] && grep -q "t.0001.exr" "$tmp/limited.err" || fail "a failed write: exit $rc: $(cat "$tmp/limited.err")"
+grep -q "frames rendered" "$tmp/limited.txt" && fail "a failed write still reported: $(cat "$tmp/limited.txt")"
+[ -z "$(ls "$tmp/limited")" ] || fail "a failed write left files: $(ls "$tmp/limited")"
+# SIGINT while frames render and write: exit 130, the frames finished before it whole, no temporary left
+mkdir -p "$tmp/int"
+"$veil" turntable "$scene" -o "$tmp/int/t.####.exr" --frames 400 --width 64 --height 48 > /dev/null 2>&1 &
+pid=$!
+for _ in $(seq 1 600); do [ -e "$tmp/int/t.0003.exr" ] && break; sleep 0.05; done
+kill -INT $pid; wait $pid; rc=$?
+[ $rc -eq 130 ] || fail "SIGINT during a turntable: exit $rc, expected 130"
+ls "$tmp/int" | grep -q -e 'veil-staged' -e '\.tmp' && fail "SIGINT left temporaries: $(ls "$tmp/int")"
+n=0
+for f in "$tmp/int"/t.*.exr; do
+  "$veil" compare "$f" "$f" > /dev/null 2>&1 || fail "SIGINT left $f unreadable"
+  n=$((n + 1))
+done
+[ $n -ge 3 ] && [ $n -lt 400 ] || fail "SIGINT: $n frames written"
 echo "PASS"
