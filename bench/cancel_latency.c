@@ -142,7 +142,9 @@ int main(int argc, char** argv)
             veil_image_destroy(img);
             img = NULL;
             veil_context_destroy(ctx);
-            if (r != VEIL_ERR_CANCELLED) {
+            /* VEIL_OK: the cancel came at a report after which no work could be cut short (the last stage's
+             * end: the render returns its image); its return still counts */
+            if (r != VEIL_ERR_CANCELLED && r != VEIL_OK) {
                 fprintf(stderr, "%s: cancel at call %d: %s (%s)\n", argv[a], c.cancel_at, veil_result_name(r), err.msg);
                 return 1;
             }
