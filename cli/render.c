@@ -39,8 +39,9 @@ static int parse_render_args(int argc, char** argv, render_args* a)
         if (!strcmp(s, "--stats")) { a->stats = 1; continue; }
         if (!strcmp(s, "--explain")) { a->explain = 1; continue; }
         if (!strcmp(s, "--aovs")) { a->aovs = 1; continue; }
-        int xrc;
-        if (veil_cli_exr_option(s, v, &a->exr_format, &xrc)) {
+        int xrc; /* the EXR's storage (cli/cli_util.h) */
+        if ((!strcmp(s, "--exr-type") || !strcmp(s, "--exr-compression") || !strcmp(s, "--dwa-level")) &&
+            veil_cli_exr_option(s, v, &a->exr_format, &xrc)) {
             if (xrc >= 0) return xrc;
             ++i;
             continue;

@@ -62,8 +62,9 @@ static int parse_args(int argc, char** argv, tt_args* a)
         if (!strcmp(s, "--skip-missing")) { a->skip_missing = 1; continue; }
         if (!strcmp(s, "--quiet")) { veil_cli_progress_mode(-1); continue; }
         if (!strcmp(s, "--progress")) { veil_cli_progress_mode(1); continue; }
-        int xrc;
-        if (veil_cli_exr_option(s, v, &a->exr_format, &xrc)) {
+        int xrc; /* the EXR's storage (cli/cli_util.h) */
+        if ((!strcmp(s, "--exr-type") || !strcmp(s, "--exr-compression") || !strcmp(s, "--dwa-level")) &&
+            veil_cli_exr_option(s, v, &a->exr_format, &xrc)) {
             if (xrc >= 0) return xrc;
             ++i;
             continue;
