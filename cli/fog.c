@@ -209,7 +209,8 @@ int veil_cmd_fog(int argc, char** argv)
     veil_render_stats st = {0};
     if (r == VEIL_OK) r = veil_renderer_create_deferred(NULL, &ren, &err);
     if (r == VEIL_OK) {
-        veil_render_opts opts = {.behind = frame, .behind_distance = depth, .behind_not_solid = a.no_occluders};
+        veil_render_opts opts = {.behind = frame, .behind_distance = depth, .behind_not_solid = a.no_occluders,
+                                 .flat_only = !a.aovs};
         veil_cli_progress_begin(NULL);
         r = veil_render_scene_images(ren, &scene, &opts, &im, &st, &err);
         veil_cli_progress_end();

@@ -176,7 +176,8 @@ int veil_cmd_render(int argc, char** argv)
         veil_render_opts opts = {.width = (int)a.width, .height = (int)a.height, .step_voxels = a.step,
                                  .seed = (uint32_t)a.seed, .method = a.method, .quality = a.quality,
                                  .sun_across = a.sun_across, .sun_along = a.sun_along, .camera = &cam,
-                                 .deep = a.deep != NULL, .deep_samples = (int)a.deep_samples};
+                                 .deep = a.deep != NULL, .deep_samples = (int)a.deep_samples,
+                                 .flat_only = !a.aovs};
         veil_render_stats st = {0};
         char label[64] = "";
         if (frames > 1) snprintf(label, sizeof label, "frame %ld/%ld", f + 1, frames);

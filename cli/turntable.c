@@ -156,7 +156,8 @@ static veil_render_opts opts_of(const tt_args* a, long frame, const veil_camera*
     return (veil_render_opts){.width = (int)a->width, .height = (int)a->height, .step_voxels = a->step,
                               .seed = veil_frame_seed((uint32_t)a->seed, frame), .method = a->method,
                               .quality = a->quality, .sun_across = a->sun_across, .sun_along = a->sun_along,
-                              .camera = cam, .deep = a->deep != NULL, .deep_samples = (int)a->deep_samples};
+                              .camera = cam, .deep = a->deep != NULL, .deep_samples = (int)a->deep_samples,
+                              .flat_only = !a->aovs};
 }
 
 /* FNV-1a of the scene file's bytes (0 when it cannot be read: it was, a moment ago). */

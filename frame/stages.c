@@ -536,6 +536,12 @@ static veil_result render_build(veil_frame* f, veil_stage_report* rep, veil_erro
                           .band_work = p->hardware ? VEIL_MARCH_DISPATCH_WORK : VEIL_MARCH_SOFTWARE_WORK,
                           .band_seconds = p->hardware ? 0.0 : VEIL_MARCH_BAND_SECONDS};
     md.medium.opv = opv;
+    if (o->flat_only) { /* only what the steps after the march read (spread_build, the behind, the deep image) */
+        const veil_multiple* ms = &p->scene->multiple;
+        const int spread = ms->screen_space && (o->behind || !ms->volumetric);
+        md.skip_reads = VEIL_MARCH_READ_V | VEIL_MARCH_READ_Z | (spread && !ms->volumetric ? 0 : VEIL_MARCH_READ_Q) |
+                        (spread ? 0 : VEIL_MARCH_READ_S) | (spread || o->behind || o->deep ? 0 : VEIL_MARCH_READ_T);
+    }
     /* the cache's later light gathered towards the camera: as the scene says, else the rung's where the
      * phase function's forward peak holds at least half its scattering (render/march.h) */
     const veil_quality_rung* q = veil_quality_rung_of(o->quality);
@@ -553,6 +559,12 @@ static veil_result render_build(veil_frame* f, veil_stage_report* rep, veil_erro
                  f->solid.maps == 1 ? "" : "s", f->solid_ms);
     }
     veil_result res = veil_march_run(f->parts->march, &md, f->images, err);
+    const veil_march_readback rb = veil_march_last_readback(f->parts->march);
+    if (res == VEIL_OK) {
+        size_t len = strlen(rep->why);
+        snprintf(rep->why + len, sizeof rep->why - len, "; %d image%s read back (%.0f MB) in %.0f ms%s", rb.images,
+                 rb.images == 1 ? "" : "s", rb.bytes / 1e6, rb.ms, rb.made ? ", the images made for this size" : "");
+    }
     const veil_march_gather g = veil_march_last_gather(f->parts->march);
     if (res == VEIL_OK && g.rays > 0) {
         size_t len = strlen(rep->why);

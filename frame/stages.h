@@ -73,6 +73,10 @@ typedef struct veil_render_opts {
      * (0: the scene's "deep": {"samples"}, else VEIL_DEEP_DEFAULT_SAMPLES) */
     int deep;
     int deep_samples;
+    /* 1: the caller keeps R, G, B, A alone (an EXR without AOVs): the march's other images are read back
+     * only where a later step needs them (the screen-space spread, a frame behind, the deep image), and Z
+     * is not made (issue 42) */
+    int flat_only;
 } veil_render_opts;
 
 /* opts (NULL: all defaults) with every zero replaced by what it means for

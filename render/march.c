@@ -37,9 +37,13 @@ struct veil_march {
     GLuint ubo, medium_ubo;
     GLuint gather[4]; /* render/shaders/cache_gather.comp, at 2 sparse + solid; made when first needed */
     veil_march_gather last_gather;
+    GLuint images[VEIL_MARCH_IMAGES]; /* the march's images, kept for the next frame of the same size */
+    int images_w, images_h;
+    veil_march_readback last_readback;
 };
 
 veil_march_gather veil_march_last_gather(const veil_march* m) { return m->last_gather; }
+veil_march_readback veil_march_last_readback(const veil_march* m) { return m->last_readback; }
 
 static veil_result gather_variant(veil_march* m, int v, veil_error* err)
 {
@@ -122,6 +126,7 @@ void veil_march_destroy(veil_march* m)
     if (!m) return;
     for (int i = 0; i < MARCH_PROGRAMS; ++i) glDeleteProgram(m->programs[i].program);
     for (int v = 0; v < 4; ++v) glDeleteProgram(m->gather[v]);
+    glDeleteTextures(VEIL_MARCH_IMAGES, m->images);
     glDeleteBuffers(1, &m->ubo);
     glDeleteBuffers(1, &m->medium_ubo);
     free(m);
@@ -373,13 +378,31 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
     int w = d->width, h = d->height;
     size_t floats;
     if (!veil_mul_sizes((size_t)w, (size_t)h, 4, 1, &floats)) return veil_fail(err, VEIL_ERR_LIMIT, "image too large");
-    enum { N = 5 };
-    GLuint tex[N] = {0};
+    enum { N = VEIL_MARCH_IMAGES };
     static const char* const labels[N] = {"veil image", "veil image T, P", "veil image single, depth",
                                           "veil image volumetric", "veil image out-scattered single"};
     static const GLuint units[N] = {VEIL_IMAGE_OUT, VEIL_IMAGE_AOV_T, VEIL_IMAGE_AOV_S, VEIL_IMAGE_AOV_V,
                                     VEIL_IMAGE_AOV_Q};
-    for (int i = 0; i < N && r == VEIL_OK; ++i) r = image(w, h, labels[i], &tex[i], err);
+    /* the images, made once per size: every pixel of each is written by every march */
+    memset(&m->last_readback, 0, sizeof m->last_readback);
+    if (m->images_w != w || m->images_h != h || !m->images[0]) {
+        glDeleteTextures(N, m->images);
+        memset(m->images, 0, sizeof m->images);
+        m->images_w = m->images_h = 0;
+        for (int i = 0; i < N && r == VEIL_OK; ++i) r = image(w, h, labels[i], &m->images[i], err);
+        if (r != VEIL_OK) {
+            glDeleteTextures(N, m->images);
+            memset(m->images, 0, sizeof m->images);
+        } else {
+            m->images_w = w, m->images_h = h, m->last_readback.made = 1;
+        }
+    }
+    const GLuint* tex = m->images;
+    /* what is read back: rgba always; the others unless the caller said it needs them not (T for the
+     * environment behind this function adds, S for Z) */
+    const int env = !d->no_background && sees_environment(lm->scene);
+    int read[N] = {1, !(d->skip_reads & VEIL_MARCH_READ_T) || env, !(d->skip_reads & VEIL_MARCH_READ_S),
+                   !(d->skip_reads & VEIL_MARCH_READ_V), !(d->skip_reads & VEIL_MARCH_READ_Q)};
     GLuint limit = 0;
     if (r == VEIL_OK && d->end_distance) {
         glCreateTextures(GL_TEXTURE_2D, 1, &limit);
@@ -390,6 +413,7 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
     }
     float** dst[N] = {&out->rgba, &out->aov_t, &out->aov_s, &out->aov_v, &out->aov_q};
     for (int i = 0; i < N && r == VEIL_OK; ++i) {
+        if (!read[i]) continue;
         *dst[i] = malloc(floats * sizeof(float));
         if (!*dst[i]) r = veil_fail(err, VEIL_ERR_OOM, "out of memory for a %dx%d image", w, h);
     }
@@ -512,12 +536,17 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_MEDIUM, 0);
         glUseProgram(0);
         if (r == VEIL_OK) r = veil_gl_check("ray march (render/shaders/march.comp)", err);
-        for (int i = 0; i < N && r == VEIL_OK; ++i)
+        if (r == VEIL_OK) glFinish(); /* the march's work done: what follows is the reading */
+        const double t_read = veil_now_ms();
+        for (int i = 0; i < N && r == VEIL_OK; ++i) {
+            if (!read[i]) continue;
             r = veil_gl_read_texture(tex[i], GL_RGBA, floats, *dst[i], "reading back the image", err);
-        if (r == VEIL_OK) r = planar_depth(d, out, err);
-        if (r == VEIL_OK && !d->no_background && sees_environment(lm->scene)) r = environment_behind(d, out, err);
+            m->last_readback.images += 1, m->last_readback.bytes += (double)floats * sizeof(float);
+        }
+        m->last_readback.ms = veil_now_ms() - t_read;
+        if (r == VEIL_OK && out->aov_s && !(d->skip_reads & VEIL_MARCH_READ_Z)) r = planar_depth(d, out, err);
+        if (r == VEIL_OK && env) r = environment_behind(d, out, err);
     }
-    glDeleteTextures(N, tex);
     glDeleteTextures(1, &limit);
     glDeleteBuffers(2, deep_buf);
     free(deep_counts);

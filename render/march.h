@@ -91,7 +91,21 @@ typedef struct veil_march_desc {
                                   on a software rasteriser); 0: the first; without one, always the first */
     double band_seconds;       /* > 0 (with a progress sink): after the first band, each sized from the last's
                                   pace to take this long (VEIL_MARCH_BAND_SECONDS on a software rasteriser) */
+    int skip_reads;            /* VEIL_MARCH_READ_* bits: images the caller does not need read back (their
+                                  buffers stay NULL), and Z not made (VEIL_MARCH_READ_Z); rgba always is read */
 } veil_march_desc;
+
+/* The march's images besides rgba, for veil_march_desc.skip_reads (issue 42: a 1080p frame read back
+ * 166 MB of five rgba32f images when its EXR held R, G, B, A). */
+enum { VEIL_MARCH_READ_T = 1, VEIL_MARCH_READ_S = 2, VEIL_MARCH_READ_V = 4, VEIL_MARCH_READ_Q = 8, VEIL_MARCH_READ_Z = 16 };
+
+/* What the last veil_march_run read back (--stats): images, bytes and the time of the reading (after the
+ * march's GPU work finished), and whether the images were made anew (a new size) or kept. */
+typedef struct veil_march_readback {
+    int images, made;
+    double bytes, ms;
+} veil_march_readback;
+veil_march_readback veil_march_last_readback(const veil_march* m);
 
 /* What the last veil_march_run gathered (render/shaders/cache_gather.comp): rays 0 when it did not. */
 typedef struct veil_march_gather {
@@ -108,7 +122,8 @@ void veil_march_destroy(veil_march* m); /* accepts NULL */
 /* The march's own uniform block for d (the medium's: veil_lit_medium_fill). */
 veil_result veil_march_block_fill(const veil_march_desc* d, veil_march_block* out, veil_error* err);
 
-/* Marches every pixel and reads the image set back (*out: freed first). */
+/* Marches every pixel and reads the image set back (*out: freed first). The march's images are kept
+ * between calls of the same size (a turntable's frames make them once). */
 veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_set* out, veil_error* err);
 
 /* Whether a w x h frame fits this device and this machine (issue 41: a
