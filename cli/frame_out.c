@@ -37,9 +37,13 @@ void veil_cli_print_deep(const veil_deep_report* d)
 
 void veil_cli_print_stages(const veil_render_stats* st)
 {
-    for (int i = 0; i < VEIL_STAGE_COUNT; ++i)
-        printf("%-10s %9.2f ms  (%s: %s)\n", veil_stage_name((veil_stage_id)i), st->stage[i].ms,
-               veil_stage_status_name(st->stage[i].status), st->stage[i].why);
+    for (int i = 0; i < VEIL_STAGE_COUNT; ++i) {
+        const veil_stage_report* s = &st->stage[i];
+        char gpu[64] = ""; /* the GPU's share, where a timer query measured it */
+        if (s->status == VEIL_STAGE_RAN && s->gpu_ms >= 0.0) snprintf(gpu, sizeof gpu, "; GPU %.2f ms of it", s->gpu_ms);
+        printf("%-10s %9.2f ms  (%s: %s%s)\n", veil_stage_name((veil_stage_id)i), s->ms,
+               veil_stage_status_name(s->status), s->why, gpu);
+    }
 }
 
 /* ---- the writer thread ---------------------------------------------------------------------------- */

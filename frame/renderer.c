@@ -19,6 +19,7 @@ struct veil_renderer {
     int ready;                        /* 1: the GL context and the stages' objects are made */
     veil_gl* own_gl;                  /* a deferred renderer's context, made by it and destroyed with it */
     veil_gl_desc gl_desc;             /* what to make it with */
+    GLuint query;                     /* a stage's GPU time (GL_TIME_ELAPSED), for --stats */
 };
 
 /* ---- lifetime ---------------------------------------------------------- */
@@ -35,6 +36,7 @@ static veil_result make_parts(veil_renderer* r, const veil_gl* gl, veil_error* e
     if (res == VEIL_OK) res = veil_volumetric_create(&p->volumetric, err);
     if (res == VEIL_OK) res = veil_march_create(&p->march, err);
     if (res == VEIL_OK) res = veil_spread_create(&p->spread, err);
+    if (res == VEIL_OK) glCreateQueries(GL_TIME_ELAPSED, 1, &r->query);
     r->ready = res == VEIL_OK;
     return res;
 }
@@ -91,6 +93,7 @@ void veil_renderer_destroy(veil_renderer* r)
     veil_volumetric_destroy(r->parts.volumetric);
     veil_march_destroy(r->parts.march);
     veil_spread_destroy(r->parts.spread);
+    if (r->query) glDeleteQueries(1, &r->query);
     veil_gl_destroy(r->own_gl);
     free(r);
 }
@@ -140,9 +143,21 @@ static veil_result run_frame(veil_renderer* r, veil_frame* f, veil_render_stats*
         rep->status = row->decide(&f->plan, kept, rep->why, sizeof rep->why);
         /* inject makes the GPU's side itself, once its sources are open and their work estimated */
         if (rep->status == VEIL_STAGE_RAN && row->id != VEIL_STAGE_INJECT) res = make_gpu(f, err);
+        /* its GPU time apart from its wall time (--stats), on a GPU (a software rasteriser's timer queries
+         * answer 0: its work is the CPU's, in the wall time); from here, where the context is made (inject
+         * makes its own on a deferred renderer's first frame: that stage's GPU time is then not measured) */
+        const int timed = res == VEIL_OK && rep->status == VEIL_STAGE_RAN && r->ready && r->query && r->hardware;
+        rep->gpu_ms = -1.0;
+        if (timed) glBeginQuery(GL_TIME_ELAPSED, r->query);
         if (res == VEIL_OK && rep->status == VEIL_STAGE_RAN) res = row->build(f, rep, err);
         if (res == VEIL_OK && row->settle) row->settle(f, rep);
         if (r->ready) glFinish();
+        if (timed) {
+            glEndQuery(GL_TIME_ELAPSED);
+            GLuint64 ns = 0;
+            glGetQueryObjectui64v(r->query, GL_QUERY_RESULT, &ns);
+            rep->gpu_ms = (double)ns * 1e-6;
+        }
         rep->ms = veil_now_ms() - t0 - (f->gpu_ms - gpu0);
     }
     veil_progress_set_stage(NULL);

@@ -32,6 +32,7 @@ typedef struct veil_stage_report {
     veil_stage_status status;
     uint64_t key;                  /* 0 when skipped */
     double ms;                     /* wall time, GPU work finished */
+    double gpu_ms;                 /* of it, the GPU's work (a GL timer query); < 0: not measured */
     char why[VEIL_STAGE_WHY_MAX];  /* why it ran, was cached or skipped, and what it did */
 } veil_stage_report;
 
