@@ -466,6 +466,27 @@ veil_result veil_image_write_exr(const veil_image* img, const char* path, int ao
     return veil_image_set_write_exr(&img->set, path, aovs, err);
 }
 
+veil_result veil_image_write_exr_as(const veil_image* img, const char* path, int aovs, const char* type,
+                                    const char* compression, veil_error* err)
+{
+    if (!img) return VEIL__NULL_ARG("veil_image_write_exr_as", "img");
+    if (!path) return VEIL__NULL_ARG("veil_image_write_exr_as", "path");
+    veil_exr_meta meta = {0};
+    if (type && strcmp(type, "float") && strcmp(type, "half"))
+        return veil_fail(err, VEIL_ERR_INVALID, "veil_image_write_exr_as: type '%.32s': expected \"float\" or \"half\"",
+                         type);
+    meta.format.half = type && !strcmp(type, "half");
+    if (compression) {
+        meta.format.compression = veil_exr_compression_parse(compression);
+        if (meta.format.compression <= 0)
+            return veil_fail(err, VEIL_ERR_INVALID, "veil_image_write_exr_as: compression '%.32s': expected zip, none, "
+                             "rle, zips, piz, pxr24, b44, b44a, dwaa or dwab", compression);
+    }
+    veil_result r = check_not_input(img, "veil_image_write_exr_as", path, err);
+    if (r != VEIL_OK) return r;
+    return veil_image_set_write_exr_meta(&img->set, path, aovs, &meta, err);
+}
+
 veil_result veil_image_write_png(const veil_image* img, const char* path, float exposure, veil_error* err)
 {
     if (!img) return VEIL__NULL_ARG("veil_image_write_png", "img");

@@ -59,14 +59,14 @@
 /* This header's version (CMakeLists.txt reads the project's version from
  * these three lines). */
 #define VEIL_VERSION_MAJOR 0
-#define VEIL_VERSION_MINOR 4
+#define VEIL_VERSION_MINOR 5
 #define VEIL_VERSION_PATCH 0
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* The loaded library's version: "0.4.0". */
+/* The loaded library's version: "0.5.0". */
 VEIL_API const char* veil_version(void);
 
 /* The loaded library's version as numbers (each output may be NULL). */
@@ -250,6 +250,15 @@ VEIL_API veil_result veil_image_channel(const veil_image* img, const char* name,
  * particle or environment map file, also through a link): VEIL_ERR_INVALID
  * naming both, and the file is left as it was. */
 VEIL_API veil_result veil_image_write_exr(const veil_image* img, const char* path, int aovs, veil_error* err);
+
+/* The same with the pixels stored as `type` ("float", or "half": 16-bit, except the distances Z and
+ * depth and the density integral P, which stay float) and `compression` ("zip", "none", "rle", "zips",
+ * "piz", and the lossy "pxr24", "b44", "b44a", "dwaa", "dwab"), as Blender's and Nuke's EXR outputs
+ * offer; NULL: "float", "zip" (veil_image_write_exr's). The chunks are compressed on every core (the
+ * environment's VEIL_EXR_THREADS=N: on N). VEIL_ERR_INVALID naming the argument for any other name.
+ * (veil 0.5) */
+VEIL_API veil_result veil_image_write_exr_as(const veil_image* img, const char* path, int aovs, const char* type,
+                                             const char* compression, veil_error* err);
 
 /* 8-bit sRGB PNG preview of the radiance times 2^exposure, tone-mapped. */
 VEIL_API veil_result veil_image_write_png(const veil_image* img, const char* path, float exposure, veil_error* err);

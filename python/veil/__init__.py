@@ -39,7 +39,7 @@ def _numbers():
     return tuple(x.value for x in v)
 
 
-#: the loaded library's version (veil_version()), e.g. "0.4.0"
+#: the loaded library's version (veil_version()), e.g. "0.5.0"
 __version__ = _cdll.veil_version().decode()
 #: the same as numbers: (major, minor, patch)
 version_info = _numbers()

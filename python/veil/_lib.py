@@ -126,6 +126,7 @@ _PROTOTYPES = {
     "veil_image_rgba": (_c.POINTER(_c.c_float), [_P]),
     "veil_image_channel": (_c.c_int32, [_P, _c.c_char_p, _c.POINTER(_c.c_float), _ERR]),
     "veil_image_write_exr": (_c.c_int32, [_P, _c.c_char_p, _c.c_int, _ERR]),
+    "veil_image_write_exr_as": (_c.c_int32, [_P, _c.c_char_p, _c.c_int, _c.c_char_p, _c.c_char_p, _ERR]),
     "veil_image_write_png": (_c.c_int32, [_P, _c.c_char_p, _c.c_float, _ERR]),
     "veil_image_stage_count": (_c.c_int, [_P]),
     "veil_image_stage": (
@@ -135,7 +136,7 @@ _PROTOTYPES = {
     ),
     "veil_image_destroy": (None, [_P]),
 }
-_OPTIONAL = {"veil_scene_set_grid", "veil_scene_create"}  # veil 0.3 on, veil 0.4 on
+_OPTIONAL = {"veil_scene_set_grid", "veil_scene_create", "veil_image_write_exr_as"}  # veil 0.3, 0.4, 0.5 on
 
 
 # ---- finding the library -------------------------------------------------

@@ -325,12 +325,41 @@ def _image_arrays(img, aovs):
     return out
 
 
-def _write(img, path, aovs, exposure):
+_EXR_TYPES = ("float", "half")
+_EXR_COMPRESSIONS = ("zip", "none", "rle", "zips", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab")
+
+
+def _exr_format(exr):
+    """exr= checked: None, or a dict {"type": "float"|"half", "compression": NAME} (each key optional), as
+    (type, compression) with None for a key left out."""
+    if exr is None:
+        return None
+    if not isinstance(exr, collections.abc.Mapping):
+        raise TypeError("exr: expected a dict such as {\"type\": \"half\", \"compression\": \"dwaa\"}, got %s"
+                        % type(exr).__name__)
+    unknown = sorted(set(exr) - {"type", "compression"})
+    if unknown:
+        raise ValueError("exr: unknown key %r (the keys are \"type\" and \"compression\")" % unknown[0])
+    kind, comp = exr.get("type"), exr.get("compression")
+    if kind is not None and kind not in _EXR_TYPES:
+        raise ValueError("exr: type %r: expected \"float\" or \"half\"" % (kind,))
+    if comp is not None and comp not in _EXR_COMPRESSIONS:
+        raise ValueError("exr: compression %r: expected one of %s" % (comp, ", ".join(_EXR_COMPRESSIONS)))
+    if not hasattr(_Lib.lib, "veil_image_write_exr_as"):
+        raise VeilError(RESULT_CODES["VEIL_ERR_INVALID"], "exr: the loaded libveil.so (veil %s) writes only float ZIP "
+                        "EXRs: the type and compression need veil 0.5 or later" % _Lib.lib.veil_version().decode())
+    return kind, comp
+
+
+def _write(img, path, aovs, exposure, exr=None):
     lib = _Lib.lib
     err = _err()
     ext = os.path.splitext(os.fspath(path))[1].lower()
     p = os.fsencode(path)
-    if ext == ".exr":
+    if ext == ".exr" and exr is not None:
+        code = lib.veil_image_write_exr_as(img, p, 1 if aovs else 0, exr[0].encode() if exr[0] else None,
+                                           exr[1].encode() if exr[1] else None, ctypes.byref(err))
+    elif ext == ".exr":
         code = lib.veil_image_write_exr(img, p, 1 if aovs else 0, ctypes.byref(err))
     elif ext == ".png":
         code = lib.veil_image_write_png(img, p, ctypes.c_float(exposure), ctypes.byref(err))
@@ -409,13 +438,13 @@ class _FrameWriter:
         if self._thread is not None and not self._thread.is_alive():
             self.wait()
 
-    def put(self, img, path, aovs, exposure):
+    def put(self, img, path, aovs, exposure, exr=None):
         """Writes img to path on the writer's thread and destroys it there."""
         self.wait()
 
         def run():
             try:
-                _write(img, path, aovs, exposure)
+                _write(img, path, aovs, exposure, exr)
             except BaseException as exc:  # raised on the caller's thread by the next wait
                 self._error = exc
             finally:
@@ -426,7 +455,7 @@ class _FrameWriter:
 
 
 def _render_one(ctx, scn, width, height, seed, step_voxels, frame, frames, progress, output, aovs, exposure,
-                writer=None):
+                writer=None, exr=None):
     lib = _Lib.lib
     handle = ctx._use()
     fn, close_bar = _progress.resolve(progress, "frame %d: " % frame if frames > 1 else "")
@@ -468,10 +497,10 @@ def _render_one(ctx, scn, width, height, seed, step_voxels, frame, frames, progr
         if output is not None:
             _check_not_scene(output, scn.file)
             if writer is not None:
-                writer.put(img, output, aovs, exposure)
+                writer.put(img, output, aovs, exposure, exr)
                 img = None  # the writer's now: it destroys it
             else:
-                _write(img, output, aovs, exposure)
+                _write(img, output, aovs, exposure, exr)
             out.path = os.fspath(output)
         return out
     finally:
@@ -480,7 +509,7 @@ def _render_one(ctx, scn, width, height, seed, step_voxels, frame, frames, progr
 
 
 def render(scene, grids=None, quality=None, size=None, seed=0, step_voxels=None, frame=0, frames=0,
-           progress=None, context=None, base_dir=None, output=None, aovs=True, exposure=0.0):
+           progress=None, context=None, base_dir=None, output=None, aovs=True, exposure=0.0, exr=None):
     """Renders a scene; returns a dict of float32 numpy arrays, each H x W x C, top row first.
 
     scene: a dict (the scene format of docs/scene-format.md), JSON text, or a
@@ -515,6 +544,11 @@ def render(scene, grids=None, quality=None, size=None, seed=0, step_voxels=None,
         an existing file is left as it was, when the render fails or is
         cancelled.
     aovs: False returns "rgba" only (and writes an EXR of R, G, B, A only).
+    exr: how an EXR output stores its pixels, as Blender's and Nuke's EXR
+        outputs offer: {"type": "float" or "half", "compression": "zip",
+        "none", "rle", "zips", "piz", or the lossy "pxr24", "b44", "b44a",
+        "dwaa", "dwab"}; None (or a key left out): float, zip. In a half
+        file the distances ("depth", Z) and P stay float. (veil 0.5)
 
     Returns a dict (veil.Result, with .width, .height, .stages, .path) of
     numpy float32 arrays of shape (height, width, C), row 0 the top row:
@@ -538,12 +572,13 @@ def render(scene, grids=None, quality=None, size=None, seed=0, step_voxels=None,
     frames = _number("frames", frames, 0, 2**31 - 1, integer=True)
     frame = _number("frame", frame, 0, max(frames - 1, 0), integer=True)
     _check_output(output)
+    exr = _exr_format(exr)
     _progress.check(progress)
     scn = _Scene(scene, grids, quality, base_dir, progress)  # a bad scene is reported before any GL work
     try:
         ctx = context if context is not None else default_context()
         return _render_one(ctx, scn, width, height, int(seed), step, int(frame), int(frames), progress, output,
-                           aovs, exposure)
+                           aovs, exposure, exr=exr)
     finally:
         scn.close()
 
@@ -561,7 +596,7 @@ def _frame_path(output, frame):
 
 
 def turntable(scene, frames, grids=None, quality=None, size=None, seed=0, step_voxels=None, progress=None,
-              context=None, base_dir=None, output=None, aovs=True, exposure=0.0, start=0, stop=None):
+              context=None, base_dir=None, output=None, aovs=True, exposure=0.0, start=0, stop=None, exr=None):
     """Yields (frame, dict) for frames start..stop-1 of a turntable of `frames` frames.
 
     One full turn about the camera's up axis through its look-at point, in
@@ -585,17 +620,18 @@ def turntable(scene, frames, grids=None, quality=None, size=None, seed=0, step_v
         _check_output(output)
         _frame_path(output, 0)
     _progress.check(progress)
+    exr = _exr_format(exr)
     if context is not None:
         context._use()
     width, height = _size(size)
     seed = _number("seed", seed, 0, 2**32 - 1, integer=True)
     step = 0.0 if step_voxels is None else float(_number("step_voxels", step_voxels, 1e-6, 1e6))
     return _turntable(context, scene, grids, quality, base_dir, width, height, int(seed), step, int(frames), int(start),
-                      int(stop), progress, output, aovs, exposure)
+                      int(stop), progress, output, aovs, exposure, exr)
 
 
 def _turntable(ctx, scene, grids, quality, base_dir, width, height, seed, step, frames, start, stop, progress,
-               output, aovs, exposure):
+               output, aovs, exposure, exr):
     scn = _Scene(scene, grids, quality, base_dir, progress)
     writer = _FrameWriter() if output is not None else None
     try:
@@ -605,7 +641,7 @@ def _turntable(ctx, scene, grids, quality, base_dir, width, height, seed, step, 
             if writer is not None:
                 writer.raise_if_failed()
             yield f, _render_one(ctx, scn, width, height, seed, step, f, frames, progress, path, aovs, exposure,
-                                 writer)
+                                 writer, exr)
         if writer is not None:
             writer.wait()  # the last frame whole before the generator ends
     finally:

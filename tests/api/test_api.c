@@ -218,6 +218,15 @@ static void render_and_read(veil_context* ctx, const veil_scene* scene)
     CHECK(veil_image_write_exr(img, bad, 0, &err) != VEIL_OK && !file_exists(bad), "write_exr to a missing folder");
     CHECK(veil_image_write_png(img, png, INFINITY, &err) == VEIL_ERR_INVALID, "non-finite exposure");
     CHECK(veil_image_write_exr(img, NULL, 0, &err) == VEIL_ERR_INVALID, "write_exr(NULL path)");
+    /* veil 0.5: the type and compression by name; a bad name refused naming it, nothing written */
+    remove(exr);
+    CHECK(veil_image_write_exr_as(img, exr, 1, "double", NULL, &err) == VEIL_ERR_INVALID && strstr(err.msg, "double") &&
+          !file_exists(exr), "write_exr_as, type 'double': %s", err.msg);
+    CHECK(veil_image_write_exr_as(img, exr, 1, NULL, "lzma", &err) == VEIL_ERR_INVALID && strstr(err.msg, "lzma") &&
+          !file_exists(exr), "write_exr_as, compression 'lzma': %s", err.msg);
+    CHECK(veil_image_write_exr_as(NULL, exr, 1, NULL, NULL, &err) == VEIL_ERR_INVALID, "write_exr_as(NULL image)");
+    CHECK(veil_image_write_exr_as(img, exr, 1, "half", "piz", &err) == VEIL_OK && file_exists(exr), "write_exr_as: %s",
+          err.msg);
     remove(exr);
     remove(png);
 

@@ -254,3 +254,47 @@ def test_context_is_bound_to_its_thread(gl):
     with pytest.raises(veil.VeilError, match="after close"):
         ctx.render(valid_scene())
     assert veil.default_context() is gl  # reused across calls
+
+
+def _exr_header(path):
+    """(compression code, {channel: pixel type}) from an EXR's header (OpenEXR's layout: attributes
+    name\\0 type\\0 size value, after the magic and version; pixel types 1 half, 2 float)."""
+    data = open(path, "rb").read()
+    assert data[:4] == b"\x76\x2f\x31\x01"
+    at, attrs = 8, {}
+    while data[at] != 0:
+        name_end = data.index(b"\0", at)
+        type_end = data.index(b"\0", name_end + 1)
+        size = int.from_bytes(data[type_end + 1:type_end + 5], "little")
+        attrs[data[at:name_end].decode()] = data[type_end + 5:type_end + 5 + size]
+        at = type_end + 5 + size
+    channels, cl = {}, attrs["channels"]
+    while cl[0] != 0:
+        end = cl.index(b"\0")
+        channels[cl[:end].decode()] = int.from_bytes(cl[end + 1:end + 5], "little")
+        cl = cl[end + 17:]
+    return attrs["compression"][0], channels
+
+
+def test_exr_type_and_compression(gl, tmp_path):
+    """Issue 42: exr= stores the pixels as half or float with the compression asked for (OpenEXR's codes:
+    none 0, zip 3, piz 4, dwaa 8); in a half file the distances and P stay float; a turntable's frames the
+    same; bad values raise before any render."""
+    fog = {"type": "exponential", "density": 0.5, "falloff": 1.0, "origin": [0, 0, 0], "direction": [0, 1, 0],
+           "bounds": [[-1, -1, -1], [1, 1, 1]]}
+    plain = veil.render(scene(fog), output=tmp_path / "plain.exr")
+    assert _exr_header(tmp_path / "plain.exr") == (3, {c: 2 for c in _exr_header(tmp_path / "plain.exr")[1]})
+    for kind, comp, code in (("half", "piz", 4), ("float", "none", 0), ("half", "dwaa", 8)):
+        veil.render(scene(fog), output=tmp_path / ("%s_%s.exr" % (kind, comp)), exr={"type": kind, "compression": comp})
+        got, channels = _exr_header(tmp_path / ("%s_%s.exr" % (kind, comp)))
+        assert got == code
+        for name, t in channels.items():
+            assert t == (1 if kind == "half" and name not in ("Z", "depth", "P") else 2), (kind, name, t)
+    assert {"R", "G", "B", "A", "Z", "depth", "P"} <= set(channels)
+    frames = list(veil.turntable(scene(fog), 2, output=tmp_path / "t#.exr", exr={"compression": "zips"}))
+    assert len(frames) == 2 and all(_exr_header(tmp_path / ("t%d.exr" % f))[0] == 2 for f in (0, 1))
+    for bad, exc in (({"type": "double"}, ValueError), ({"compression": "lzma"}, ValueError), ({"level": 3}, ValueError),
+                     ("half", TypeError)):
+        with pytest.raises(exc):
+            veil.render(scene(fog), output=tmp_path / "bad.exr", exr=bad)
+    assert not (tmp_path / "bad.exr").exists() and plain.path == str(tmp_path / "plain.exr")
