@@ -539,8 +539,10 @@ static veil_result render_build(veil_frame* f, veil_stage_report* rep, veil_erro
     if (o->flat_only) { /* only what the steps after the march read (spread_build, the behind, the deep image) */
         const veil_multiple* ms = &p->scene->multiple;
         const int spread = ms->screen_space && (o->behind || !ms->volumetric);
-        md.skip_reads = VEIL_MARCH_READ_V | VEIL_MARCH_READ_Z | (spread && !ms->volumetric ? 0 : VEIL_MARCH_READ_Q) |
-                        (spread ? 0 : VEIL_MARCH_READ_S) | (spread || o->behind || o->deep ? 0 : VEIL_MARCH_READ_T);
+        /* (the spread reads S where the march left it; T and Q's P for its decision, on the CPU) */
+        md.skip_reads = VEIL_MARCH_READ_V | VEIL_MARCH_READ_Z | VEIL_MARCH_READ_S |
+                        (spread && !ms->volumetric ? 0 : VEIL_MARCH_READ_Q) |
+                        (spread || o->behind || o->deep ? 0 : VEIL_MARCH_READ_T);
     }
     /* the cache's later light gathered towards the camera: as the scene says, else the rung's where the
      * phase function's forward peak holds at least half its scattering (render/march.h) */
@@ -633,8 +635,13 @@ static veil_result spread_build(veil_frame* f, veil_stage_report* rep, veil_erro
     size_t floats = (size_t)im->width * (size_t)im->height * 4;
     im->aov_m = malloc(floats * sizeof(float));
     if (!im->aov_m) return veil_fail(err, VEIL_ERR_OOM, "out of memory for the spread image");
+    /* T, S and Q read where the march left them (its images: no upload of the buffers read back) */
+    unsigned int march_images[VEIL_MARCH_IMAGES];
+    veil_march_images(f->parts->march, march_images);
     veil_spread_input in = {.width = im->width, .height = im->height, .L = o->behind, .background = {0, 0, 0},
-                            .aov_t = im->aov_t, .aov_s = im->aov_s, .aov_q = q, .fov_y_deg = vertical_fov_deg(o->camera, im->width, im->height)};
+                            .aov_t = im->aov_t, .aov_s = im->aov_s, .aov_q = q,
+                            .fov_y_deg = vertical_fov_deg(o->camera, im->width, im->height),
+                            .tex_t = march_images[1], .tex_s = march_images[2], .tex_q = q ? march_images[4] : 0};
     veil_spread_report sr = {0};
     veil_result res = veil_spread_run(f->parts->spread, s, &in, im->aov_m, NULL, &sr, err);
     if (res != VEIL_OK) return res;

@@ -45,6 +45,11 @@ struct veil_march {
 veil_march_gather veil_march_last_gather(const veil_march* m) { return m->last_gather; }
 veil_march_readback veil_march_last_readback(const veil_march* m) { return m->last_readback; }
 
+void veil_march_images(const veil_march* m, unsigned int out[VEIL_MARCH_IMAGES])
+{
+    for (int i = 0; i < VEIL_MARCH_IMAGES; ++i) out[i] = m->images[i];
+}
+
 static veil_result gather_variant(veil_march* m, int v, veil_error* err)
 {
     if (m->gather[v]) return VEIL_OK;

@@ -99,6 +99,8 @@ typedef struct veil_march_desc {
  * 166 MB of five rgba32f images when its EXR held R, G, B, A). */
 enum { VEIL_MARCH_READ_T = 1, VEIL_MARCH_READ_S = 2, VEIL_MARCH_READ_V = 4, VEIL_MARCH_READ_Q = 8, VEIL_MARCH_READ_Z = 16 };
 
+#define VEIL_MARCH_IMAGES 5 /* rgba, T, S, V, Q */
+
 /* What the last veil_march_run read back (--stats): images, bytes and the time of the reading (after the
  * march's GPU work finished), and whether the images were made anew (a new size) or kept. */
 typedef struct veil_march_readback {
@@ -106,6 +108,10 @@ typedef struct veil_march_readback {
     double bytes, ms;
 } veil_march_readback;
 veil_march_readback veil_march_last_readback(const veil_march* m);
+
+/* The last run's images (rgba, T, S, V, Q: the image set's order, render/image_set.h), kept by m until
+ * its next run of another size or its destruction: a later stage reads them on the GPU (the spread). */
+void veil_march_images(const veil_march* m, unsigned int out[VEIL_MARCH_IMAGES]);
 
 /* What the last veil_march_run gathered (render/shaders/cache_gather.comp): rays 0 when it did not. */
 typedef struct veil_march_gather {
@@ -138,7 +144,6 @@ veil_result veil_march_run(veil_march* m, const veil_march_desc* d, veil_image_s
  * software rasteriser the textures too, within the machine's physical
  * memory. VEIL_ERR_LIMIT naming what does not fit, with the largest frame
  * of the same shape that does. Needs a current GL context. */
-#define VEIL_MARCH_IMAGES 5
 #define VEIL_SPREAD_IMAGES 9 /* 4 inputs, the output, 3 chains of 4/3 of a level */
 #define VEIL_IMAGE_HOST_BYTES 192
 veil_result veil_march_check_size(int w, int h, int spread, int hardware, unsigned long long gpu_budget,

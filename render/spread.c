@@ -148,7 +148,7 @@ veil_result veil_spread_run(veil_spread* s, const veil_scene* sc, const veil_spr
     int w = in->width, h = in->height;
     if (w < 1 || h < 1 || w > VEIL_SCENE_MAX_IMAGE || h > VEIL_SCENE_MAX_IMAGE)
         return veil_fail(err, VEIL_ERR_INVALID, "spread: image size %dx%d is outside 1..%d", w, h, VEIL_SCENE_MAX_IMAGE);
-    if (!in->aov_t || !in->aov_s || !(in->fov_y_deg > 0.0f && in->fov_y_deg < 180.0f))
+    if (!(in->aov_t || in->tex_t) || !(in->aov_s || in->tex_s) || !(in->fov_y_deg > 0.0f && in->fov_y_deg < 180.0f))
         return veil_fail(err, VEIL_ERR_INVALID, "spread: missing march buffers or field of view %g", in->fov_y_deg);
     int K = veil_spread_levels(&sc->multiple, w, h);
     int step = 1 << K, pw = (w + step - 1) / step * step, ph = (h + step - 1) / step * step;
@@ -162,7 +162,7 @@ veil_result veil_spread_run(veil_spread* s, const veil_scene* sc, const veil_spr
         for (size_t i = 0; i < n; ++i)
             for (int c = 0; c < 4; ++c) L[4 * i + c] = c < 3 ? in->background[c] : 0.0f;
     }
-    if (!in->aov_q) {
+    if (!in->aov_q && !in->tex_q) {
         zeros = calloc(floats, sizeof *zeros);
         if (!zeros) {
             free(L);
@@ -175,7 +175,10 @@ veil_result veil_spread_run(veil_spread* s, const veil_scene* sc, const veil_spr
     GLuint tex[TEX] = {0};
     const void* data[4] = {in->L ? (const void*)in->L : L, in->aov_t, in->aov_s, in->aov_q ? (const void*)in->aov_q : zeros};
     veil_result r = VEIL_OK;
-    for (int i = IN_L; i <= IN_Q && r == VEIL_OK; ++i) r = texture2d(w, h, 1, data[i], "veil spread input", &tex[i], err);
+    /* T, S and Q where the march left them (its images, read in place: no round trip through the CPU) */
+    const GLuint given[4] = {0, in->tex_t, in->tex_s, in->tex_q};
+    for (int i = IN_L; i <= IN_Q && r == VEIL_OK; ++i)
+        r = given[i] ? VEIL_OK : texture2d(w, h, 1, data[i], "veil spread input", &tex[i], err);
     /* the separated chain needs every level only with separation; else one texel level keeps the binding valid */
     int sep = sc->multiple.separation != 0;
     if (r == VEIL_OK) r = texture2d(pw, ph, K + 1, NULL, "veil spread L_sc chain", &tex[SC], err);
@@ -185,12 +188,14 @@ veil_result veil_spread_run(veil_spread* s, const veil_scene* sc, const veil_spr
     free(L);
     free(zeros);
     if (r == VEIL_OK) {
+        if (given[IN_T] || given[IN_S] || given[IN_Q]) glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT); /* the march's stores */
         glBindBufferBase(GL_UNIFORM_BUFFER, VEIL_UBO_SPREAD, s->ubo);
         glNamedBufferSubData(s->ubo, 0, sizeof u, &u);
         /* 1: level 0 */
         glUseProgram(s->program[PREP]);
         for (int i = IN_L; i <= IN_Q; ++i)
-            glBindImageTexture(VEIL_SPREAD_IN_L + (GLuint)i, tex[i], 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+            glBindImageTexture(VEIL_SPREAD_IN_L + (GLuint)i, given[i] ? given[i] : tex[i], 0, GL_FALSE, 0, GL_READ_ONLY,
+                               GL_RGBA32F);
         glBindImageTexture(VEIL_SPREAD_OUT_SC, tex[SC], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glBindImageTexture(VEIL_SPREAD_OUT_P, tex[P], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glBindImageTexture(VEIL_SPREAD_OUT_SSC, tex[SSC], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);

@@ -36,6 +36,10 @@ typedef struct veil_spread_input {
     const float* aov_s;
     const float* aov_q;     /* NULL: no single scattering to spread */
     float fov_y_deg;        /* the camera's vertical field of view */
+    /* the march's own images of T, S and Q (render/march.h, veil_march_images), read where they are
+     * instead of being made from aov_t, aov_s and aov_q (which may then be NULL; tex_q 0 with aov_q NULL:
+     * no single scattering to spread); 0: made from the buffers */
+    unsigned int tex_t, tex_s, tex_q;
 } veil_spread_input;
 
 typedef struct veil_spread_report {
