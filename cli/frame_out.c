@@ -161,6 +161,21 @@ veil_result veil_cli_writer_put(veil_cli_writer* w, veil_image_set* im, long fra
     return VEIL_OK;
 }
 
+veil_result veil_cli_hand_over(veil_cli_writer** w, int stats, const veil_render_stats* st, veil_image_set* im,
+                               long frame, const char* exr, const char* png, const char* deep, int aovs,
+                               const veil_exr_meta* meta, veil_error* err)
+{
+    if (stats) { /* before the hand-over: the writer prints its own line */
+        flockfile(stdout);
+        printf("frame %ld\n", frame);
+        veil_cli_print_stages(st);
+        if (deep) veil_cli_print_deep(&st->deep);
+        funlockfile(stdout);
+    }
+    veil_result r = *w ? VEIL_OK : veil_cli_writer_start(stats, w, err);
+    return r == VEIL_OK ? veil_cli_writer_put(*w, im, frame, exr, png, deep, aovs, meta, err) : r;
+}
+
 veil_result veil_cli_writer_finish(veil_cli_writer* w, double* write_ms, double* waited_ms, veil_error* err)
 {
     if (!w) return VEIL_OK;

@@ -29,6 +29,12 @@ typedef struct veil_cli_writer veil_cli_writer;
 veil_result veil_cli_writer_start(int stats, veil_cli_writer** out, veil_error* err);
 veil_result veil_cli_writer_put(veil_cli_writer* w, veil_image_set* im, long frame, const char* exr, const char* png,
                                 const char* deep, int aovs, const veil_exr_meta* meta, veil_error* err);
+/* A turntable's frame handed over, as render --turntable and turntable do it: with stats its "frame F"
+ * and stage lines first (and its deep merge's when deep is not NULL), then the writer made when *w is
+ * NULL (stats: it prints its write's line), then veil_cli_writer_put. */
+veil_result veil_cli_hand_over(veil_cli_writer** w, int stats, const veil_render_stats* st, veil_image_set* im,
+                               long frame, const char* exr, const char* png, const char* deep, int aovs,
+                               const veil_exr_meta* meta, veil_error* err);
 /* Waits for the frames handed over, ends the thread, frees w (NULL: nothing); the first failure, if
  * any. *write_ms (may be NULL): the writes' time in all, *waited_ms the time put waited for them. */
 veil_result veil_cli_writer_finish(veil_cli_writer* w, double* write_ms, double* waited_ms, veil_error* err);

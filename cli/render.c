@@ -191,17 +191,9 @@ int veil_cmd_render(int argc, char** argv)
         if (r == VEIL_OK && a.deep) r = veil_frame_path(a.deep, f, a.frames > 0, deep, sizeof deep, &err);
         const veil_exr_meta meta = {.format = a.exr_format};
         if (frames > 1) { /* a turntable's frame is written on its own thread while the next renders */
-            if (r == VEIL_OK && a.stats) {
-                flockfile(stdout);
-                printf("frame %ld\n", f);
-                veil_cli_print_stages(&st);
-                if (a.deep) veil_cli_print_deep(&st.deep);
-                funlockfile(stdout);
-            }
-            if (r == VEIL_OK && !writer) r = veil_cli_writer_start(a.stats, &writer, &err);
             if (r == VEIL_OK)
-                r = veil_cli_writer_put(writer, &im, f, exr, a.png ? png : NULL, a.deep ? deep : NULL, a.aovs, &meta,
-                                        &err);
+                r = veil_cli_hand_over(&writer, a.stats, &st, &im, f, exr, a.png ? png : NULL, a.deep ? deep : NULL,
+                                       a.aovs, &meta, &err);
             if (r != VEIL_OK) break;
             if (f == frames - 1) snprintf(last, sizeof last, "%s%s%s", exr, a.png ? " and " : "", a.png ? png : "");
             continue;

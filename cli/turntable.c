@@ -392,19 +392,11 @@ int veil_cmd_turntable(int argc, char** argv)
                                      {"veil:settings", settings}};
         memcpy(meta.strings, strings, sizeof strings);
         meta.n_strings = 4;
-        if (r == VEIL_OK && a.stats) { /* before the hand-over: the writer prints its own line */
-            flockfile(stdout);
-            printf("frame %ld\n", frame);
-            veil_cli_print_stages(&st);
-            if (a.deep) veil_cli_print_deep(&st.deep);
-            funlockfile(stdout);
-        }
         /* the frame's files all or nothing, renamed into place, on the writer's thread while the next frame
          * renders (cli/frame_out.h) */
-        if (r == VEIL_OK && !writer) r = veil_cli_writer_start(a.stats, &writer, &err);
         if (r == VEIL_OK)
-            r = veil_cli_writer_put(writer, &im, frame, exr, a.png ? png : NULL, a.deep ? deep : NULL, a.aovs, &meta,
-                                    &err);
+            r = veil_cli_hand_over(&writer, a.stats, &st, &im, frame, exr, a.png ? png : NULL, a.deep ? deep : NULL,
+                                   a.aovs, &meta, &err);
         if (r != VEIL_OK) break;
         ++done;
         for (int k = 0; k < VEIL_STAGE_COUNT; ++k) {
